@@ -1,0 +1,79 @@
+// mbdae command-line front end:
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A]
+// Exit codes: 0 success, 1 usage, 2 invalid scene, 3 solve failure.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "cases/run_scene.h"
+#include "cases/scene.h"
+#include "core/errors.h"
+
+namespace {
+void usage() {
+  std::fprintf(stderr,
+               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
+               "       mbdae check SCENE.yaml\n");
+}
+bool parse_number(const char* s, double& v) {
+  char* end = nullptr;
+  v = std::strtod(s, &end);
+  return end && *end == '\0' && end != s;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0)) {
+    usage();
+    return 1;
+  }
+  const bool check_only = std::strcmp(argv[1], "check") == 0;
+  const std::string scene_path = argv[2];
+  mbdae::RunOptions opt;
+  for (int i = 3; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc) {
+      opt.out_dir = argv[++i];
+    } else if ((a == "--rtol" || a == "--atol") && i + 1 < argc) {
+      double v;
+      if (!parse_number(argv[++i], v) || !(v > 0) || v > 1) {
+        std::fprintf(stderr, "mbdae: %s expects a number in (0, 1], got '%s'\n", a.c_str(), argv[i]);
+        return 1;
+      }
+      (a == "--rtol" ? opt.rtol : opt.atol) = v;
+    } else if (a == "--quiet") {
+      opt.verbose = false;
+      opt.progress = false;
+    } else {
+      std::fprintf(stderr, "mbdae: unknown argument '%s'\n", a.c_str());
+      usage();
+      return 1;
+    }
+  }
+  if (!check_only && opt.out_dir.empty()) {
+    std::fprintf(stderr, "mbdae: --out DIR is required\n");
+    return 1;
+  }
+  try {
+    const mbdae::Scene scene = mbdae::load_scene(scene_path);
+    if (check_only) {
+      std::printf("%s: ok\n", scene_path.c_str());
+      return 0;
+    }
+    const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
+    return r.exit_code;
+  } catch (const mbdae::SceneError& e) {
+    for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());
+    return 2;
+  } catch (const mbdae::ModelError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  } catch (const mbdae::SolveError& e) {
+    std::fprintf(stderr, "mbdae: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mbdae: %s\n", e.what());
+    return 3;
+  }
+}

@@ -1,0 +1,323 @@
+#include "cases/run_scene.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "core/errors.h"
+#include "core/ida_driver.h"
+#include "core/output.h"
+#include "formulation/analyses.h"
+#include "formulation/index3_dae.h"
+#include "formulation/mechanics.h"
+#include "formulation/sensors.h"
+
+namespace mbdae {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+std::vector<int> coordinate_indices(const System& sys, const std::vector<std::string>& names,
+                                    const AnalysisStep& step, const std::string& field) {
+  std::vector<int> out;
+  for (const auto& n : names) {
+    const int k = sys.coordinate_index(n);
+    if (k < 0) throw ModelError(step.where.file, step.where.line, field, "no coordinate named '" + n + "'");
+    if (sys.coordinates[k].merged)
+      throw ModelError(step.where.file, step.where.line, field,
+                       "coordinate '" + n + "' is locked (its joint is merged); it cannot be held or solved for");
+    out.push_back(k);
+  }
+  return out;
+}
+
+json coordinates_json(const System& sys, const double* q) {
+  json j;
+  for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k)
+    j[sys.coordinates[k].name] = coordinate_value(sys, k, q);
+  return j;
+}
+
+json sensors_json(const System& sys, const std::vector<char>& modes, const double* q, double t) {
+  std::vector<double> v(sys.nq(), 0.0), out(sys.sensors.size());
+  evaluate_sensors(sys, modes, q, v.data(), nullptr, t, out.data());
+  json j;
+  for (size_t k = 0; k < sys.sensors.size(); ++k)
+    if (sys.sensors[k].type != SensorSpec::Type::kAcceleration) j[sys.sensors[k].name] = out[k];
+  return j;
+}
+
+void print_configuration(const System& sys, const double* q, double t) {
+  std::printf("  joint coordinates:\n");
+  for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
+    const double v = coordinate_value(sys, k, q);
+    const bool rot = sys.coordinates[k].function.rotation;
+    std::printf("    %-8s = %.12f %s", sys.coordinates[k].name.c_str(), v, rot ? "rad" : "m");
+    if (rot) std::printf("  (%.9f deg)", v * 180.0 / M_PI);
+    std::printf("%s\n", sys.coordinates[k].merged ? "  [locked]" : "");
+  }
+  const std::vector<char> modes = initial_modes(sys, q, t);
+  std::vector<double> v(sys.nq(), 0.0), out(sys.sensors.size());
+  evaluate_sensors(sys, modes, q, v.data(), nullptr, t, out.data());
+  std::printf("  sensors:\n");
+  for (size_t k = 0; k < sys.sensors.size(); ++k) {
+    const auto type = sys.sensors[k].type;
+    if (type == SensorSpec::Type::kAcceleration || type == SensorSpec::Type::kVelocity ||
+        type == SensorSpec::Type::kCoordinateRate)
+      continue;
+    std::printf("    %-12s = %.12f\n", sys.sensors[k].name.c_str(), out[k]);
+  }
+}
+
+double automatic_constraint_scale(const System& sys, const AnalysisStep& step) {
+  // Scale the constraint rows like cj^2 M at a typical step (the output step or 1e-3 s).
+  double m = 0;
+  for (const auto& b : sys.bodies) m += b.mass;
+  m = sys.bodies.empty() ? 1.0 : std::max(1e-6, m / sys.bodies.size());
+  const double h = std::min(step.output_step > 0 ? step.output_step : 1e-3, 1e-3);
+  return m / (h * h);
+}
+
+}  // namespace
+
+RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
+  RunOutcome out;
+  json& summary = out.summary;
+  summary["scene"] = scene.file;
+  summary["model"] = scene.model.name;
+  summary["status"] = "running";
+  json steps = json::array();
+  auto write_summary = [&] {
+    summary["steps"] = steps;
+    if (!opt.out_dir.empty()) write_json_file(opt.out_dir + "/summary.json", summary);
+  };
+  if (!opt.out_dir.empty()) prepare_output_folder(opt.out_dir);
+
+  System sys = build_system(scene.model);
+  summary["bodies"] = sys.num_bodies();
+  summary["coordinates"] = sys.nq();
+  summary["constraint_equations"] = sys.num_constraint_rows();
+  {
+    json merged = json::object();
+    for (const auto& b : sys.bodies)
+      if (!b.merged.empty()) merged[b.name] = b.merged;
+    json ground = json::array();
+    for (const auto& [name, f] : sys.frames)
+      if (f.body < 0 && name != kGround) ground.push_back(name);
+    summary["merged_into_body"] = merged;
+    summary["merged_into_ground"] = ground;
+  }
+  std::vector<double> q = sys.q0;
+  // Output columns.
+  std::vector<int> column_sensors;
+  if (scene.columns.empty()) {
+    for (size_t k = 0; k < sys.sensors.size(); ++k) column_sensors.push_back(static_cast<int>(k));
+  } else {
+    for (const auto& c : scene.columns) {
+      int idx = -1;
+      for (size_t k = 0; k < sys.sensors.size(); ++k)
+        if (sys.sensors[k].name == c) idx = static_cast<int>(k);
+      if (idx < 0) throw ModelError(scene.file, 0, "output", "no sensor named '" + c + "'");
+      column_sensors.push_back(idx);
+    }
+  }
+  out.columns = {"t"};
+  for (int k : column_sensors) out.columns.push_back(sys.sensors[k].name);
+
+  auto fail = [&](const std::string& status, const std::string& message, json step) {
+    step["status"] = status;
+    step["message"] = message;
+    steps.push_back(step);
+    summary["status"] = status;
+    summary["message"] = message;
+    write_summary();
+    out.exit_code = 3;
+    out.q = q;
+    if (opt.verbose) std::fprintf(stderr, "mbdae: %s\n", message.c_str());
+  };
+
+  for (const AnalysisStep& step : scene.steps) {
+    json js;
+    switch (step.type) {
+      case AnalysisStep::Type::kAssembly: {
+        js["type"] = "assembly";
+        const std::vector<int> held = coordinate_indices(sys, step.hold, step, "hold");
+        const AssemblyResult r = assemble_positions(sys, held, step.t0, q);
+        js["iterations"] = r.iterations;
+        js["max_constraint_violation"] = r.residual;
+        js["coordinates"] = coordinates_json(sys, q.data());
+        if (!r.converged) {
+          fail("assembly_failed", r.message, js);
+          return out;
+        }
+        js["sensors"] = sensors_json(sys, initial_modes(sys, q.data(), step.t0), q.data(), step.t0);
+        js["status"] = "ok";
+        if (opt.verbose) {
+          std::printf("assembly: converged in %d iterations, max constraint violation %.3g\n", r.iterations, r.residual);
+          print_configuration(sys, q.data(), step.t0);
+        }
+        break;
+      }
+      case AnalysisStep::Type::kEquilibrium: {
+        js["type"] = "equilibrium";
+        EquilibriumOptions eo;
+        eo.t = step.t0;
+        eo.hold = coordinate_indices(sys, step.hold, step, "hold");
+        eo.release = coordinate_indices(sys, step.release, step, "release");
+        for (const auto& u : step.unknowns) {
+          const size_t dot = u.rfind('.');
+          const int f = dot == std::string::npos ? -1 : sys.force_index(u.substr(0, dot));
+          Force probe = f >= 0 ? sys.forces[f] : Force{};
+          if (f < 0 || !force_parameter(probe, u.substr(dot + 1)))
+            throw ModelError(step.where.file, step.where.line, "unknowns",
+                             "'" + u + "' is not a force parameter (force.free_length, .stiffness, .damping)");
+          eo.parameters.push_back({f, u.substr(dot + 1)});
+        }
+        if (eo.release.size() != eo.parameters.size())
+          throw ModelError(step.where.file, step.where.line, "release",
+                           "one released coordinate is needed per unknown parameter");
+        const EquilibriumResult r = solve_equilibrium(sys, q, eo);
+        js["iterations"] = r.iterations;
+        js["relative_force_residual"] = r.force_residual;
+        js["constraint_residual"] = r.constraint_residual;
+        json params = json::object();
+        for (size_t p = 0; p < eo.parameters.size(); ++p) {
+          const std::string key = sys.forces[eo.parameters[p].first].name + "." + eo.parameters[p].second;
+          params[key] = r.parameter_values[p];
+          if (eo.parameters[p].second == "free_length") {
+            js["spring_free_length"] = r.parameter_values[p];
+            summary["spring_free_length"] = r.parameter_values[p];
+          }
+        }
+        js["parameters"] = params;
+        json reactions = json::object();
+        for (size_t h = 0; h < eo.hold.size(); ++h) reactions[step.hold[h]] = r.hold_reactions[h];
+        js["hold_reactions"] = reactions;
+        js["coordinates"] = coordinates_json(sys, q.data());
+        if (!r.converged) {
+          fail("equilibrium_failed", r.message, js);
+          return out;
+        }
+        js["sensors"] = sensors_json(sys, initial_modes(sys, q.data(), step.t0), q.data(), step.t0);
+        js["status"] = "ok";
+        summary["equilibrium_coordinates"] = js["coordinates"];
+        if (opt.verbose) {
+          std::printf("equilibrium: converged in %d iterations\n", r.iterations);
+          for (auto& [k, v] : params.items()) std::printf("  %s = %.12f\n", k.c_str(), v.get<double>());
+          print_configuration(sys, q.data(), step.t0);
+        }
+        break;
+      }
+      case AnalysisStep::Type::kKinematics:
+      case AnalysisStep::Type::kDynamics: {
+        js["type"] = step.type == AnalysisStep::Type::kKinematics ? "kinematics" : "dynamics";
+        js["formulation"] = step.formulation;
+        IdaOptions io;
+        io.t0 = step.t0;
+        io.t1 = step.t_end;
+        io.rtol = opt.rtol > 0 ? opt.rtol : step.rtol;
+        io.atol = opt.atol > 0 ? opt.atol : step.atol;
+        io.output_step = step.output_step;
+        io.max_step = step.max_step;
+        js["rtol"] = io.rtol;
+        js["atol"] = io.atol;
+        const double scale = step.constraint_scale > 0 ? step.constraint_scale : automatic_constraint_scale(sys, step);
+        js["constraint_scale"] = scale;
+        Index3Dae dae(sys, scale);
+        dae.modes = initial_modes(sys, q.data(), step.t0);
+        std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
+        std::copy(q.begin(), q.end(), y.begin());
+        try {
+          dae.consistent_initial_values(step.t0, y, yp);
+        } catch (const SolveError& e) {
+          fail(e.status, e.what(), js);
+          return out;
+        }
+        CsvWriter csv;
+        if (!opt.out_dir.empty()) csv.open(opt.out_dir + "/results.csv", out.columns);
+        std::vector<double> qo, vo, ao, sensors(sys.sensors.size()), row(out.columns.size());
+        double max_output_violation = 0;
+        std::vector<int> quiet;
+        for (const auto& name : step.quiet_sensors)
+          for (size_t k = 0; k < sys.sensors.size(); ++k)
+            if (sys.sensors[k].name == name) quiet.push_back(static_cast<int>(k));
+        std::vector<double> quiet_ref, quiet_max(quiet.size(), 0.0);
+        const auto wall0 = std::chrono::steady_clock::now();
+        auto last_print = wall0;
+        bool printed = false;
+        long rows = 0;
+        auto output = [&](double t, const double* yy, const double*) {
+          max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, qo, vo, ao));
+          evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), t, sensors.data());
+          row[0] = t;
+          for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];
+          if (!opt.out_dir.empty()) {
+            csv.row(row.data());
+            if (++rows % 256 == 0) csv.flush();
+          }
+          if (opt.keep_rows) out.rows.push_back(row);
+          if (quiet_ref.empty()) for (int k : quiet) quiet_ref.push_back(sensors[k]);
+          if (t < step.quiet_until)
+            for (size_t k = 0; k < quiet.size(); ++k)
+              quiet_max[k] = std::fmax(quiet_max[k], std::fabs(sensors[quiet[k]] - quiet_ref[k]));
+          if (opt.progress) {
+            const auto now = std::chrono::steady_clock::now();
+            if (now - wall0 > std::chrono::seconds(1) && now - last_print > std::chrono::milliseconds(500)) {
+              std::fprintf(stderr, "\r  t = %.4f of %.4f (%3.0f%%)", t, step.t_end,
+                           100.0 * (t - step.t0) / (step.t_end - step.t0));
+              last_print = now;
+              printed = true;
+            }
+          }
+          return true;
+        };
+        const IdaStats st = integrate(dae, io, y, yp, output);
+        if (printed) std::fprintf(stderr, "\n");
+        csv.close();
+        std::copy(y.begin(), y.begin() + sys.nq(), q.begin());
+        json stats;
+        stats["steps"] = st.steps;
+        stats["residual_evaluations"] = st.residual_evals;
+        stats["jacobian_evaluations"] = st.jacobian_evals;
+        stats["klu_factorizations"] = st.linear_setups;
+        stats["error_test_failures"] = st.error_test_failures;
+        stats["nonlinear_iterations"] = st.nonlinear_iterations;
+        stats["nonlinear_failures"] = st.nonlinear_failures;
+        stats["restarts"] = st.restarts;
+        stats["cpu_seconds"] = st.cpu_seconds;
+        stats["max_position_violation_steps"] = dae.max_position_violation;
+        stats["max_position_violation_output_before_projection"] = max_output_violation;
+        stats["max_euler_norm_drift"] = dae.max_norm_drift;
+        stats["output_rows"] = out.rows.size() ? static_cast<long>(out.rows.size()) : rows;
+        js["statistics"] = stats;
+        js["event_times"] = st.event_times;
+        js["breakpoint_times"] = st.breakpoint_times;
+        js["t_reached"] = st.t_reached;
+        if (!quiet.empty()) {
+          json qj;
+          for (size_t k = 0; k < quiet.size(); ++k) qj[sys.sensors[quiet[k]].name] = quiet_max[k];
+          js["max_change_before"] = {{"time", step.quiet_until}, {"sensors", qj}};
+        }
+        if (opt.verbose)
+          std::printf("%s: %ld steps, %ld residual evaluations, %ld KLU factorizations, %zu events, "
+                      "cpu %.3f s, max constraint violation %.2e\n",
+                      js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
+                      st.event_times.size(), st.cpu_seconds, dae.max_position_violation);
+        if (!st.ok) {
+          fail(st.status, st.message, js);
+          return out;
+        }
+        js["status"] = "ok";
+        break;
+      }
+    }
+    steps.push_back(js);
+  }
+  summary["status"] = "ok";
+  write_summary();
+  out.q = q;
+  return out;
+}
+
+}  // namespace mbdae

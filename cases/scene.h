@@ -1,0 +1,43 @@
+// A scene: a model plus the analyses to run on it, as read from YAML (see docs/scene-format.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "formulation/model.h"
+
+namespace mbdae {
+
+struct AnalysisStep {
+  enum class Type { kAssembly, kEquilibrium, kKinematics, kDynamics };
+  Type type = Type::kAssembly;
+  std::vector<std::string> hold, release, unknowns;  // unknowns: "force.parameter"
+  double t0 = 0, t_end = 1, output_step = 0.01;
+  double rtol = 1e-6, atol = 1e-8, max_step = 0;
+  double constraint_scale = 0;  // 0: automatic
+  std::string formulation = "index3";
+  // Report the largest change of these sensors before this time ("nothing moves before").
+  double quiet_until = -1;
+  std::vector<std::string> quiet_sensors;
+  SourceLocation where;
+};
+
+struct Scene {
+  std::string file;
+  Model model;
+  std::vector<AnalysisStep> steps;
+  std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
+};
+
+// One message per problem found in the scene (file:line: field 'x': ...).
+struct SceneError : std::runtime_error {
+  std::vector<std::string> messages;
+  explicit SceneError(std::vector<std::string> m);
+};
+
+// Reads a scene file (and the model file it names). Throws SceneError listing every problem.
+Scene load_scene(const std::string& path);
+// Parses a scene from text (for tests); `path` is used in messages and to resolve includes.
+Scene load_scene_text(const std::string& text, const std::string& path);
+
+}  // namespace mbdae

@@ -1,0 +1,43 @@
+// A DAE F(t, y, y') = 0 as the integrator sees it: residual, sparse Jacobian dF/dy + cj dF/dy'
+// on a fixed pattern, switching functions for events, and a restart hook that makes (y, y')
+// consistent after an event or a breakpoint. The multibody formulations implement this; the
+// integrator (ida_driver) knows nothing of bodies.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/sparse_assembler.h"
+
+namespace mbdae {
+
+class DaeProblem {
+ public:
+  virtual ~DaeProblem() = default;
+  virtual int size() const = 0;
+  virtual const CscPattern& jacobian_pattern() = 0;
+  // Return 0 on success, > 0 for a recoverable failure, < 0 for a fatal one (IDA's convention).
+  virtual int residual(double t, const double* y, const double* yp, double* r) = 0;
+  virtual int jacobian(double t, double cj, const double* y, const double* yp, double* values) = 0;
+  // 1 for components in the local error test, 0 for those left out (algebraic, velocities and
+  // multipliers of an index-3 system).
+  virtual void error_test_mask(double* id) const = 0;
+  // Absolute tolerance per component given the user's scalar atol.
+  virtual void absolute_tolerances(double atol, double* out) const {
+    for (int i = 0; i < size(); ++i) out[i] = atol;
+  }
+  virtual std::string component_name(int i) const { return "y[" + std::to_string(i) + "]"; }
+
+  // Event functions g(t, y) whose sign changes are located by root finding.
+  virtual int num_switches() const { return 0; }
+  virtual void switches(double /*t*/, const double* /*y*/, double* /*g*/) {}
+  // After an event (roots_found non-null, IDA's +-1/0 per switch) or at a breakpoint (null):
+  // update modes and make (y, y') consistent at t. Throws SolveError on failure.
+  virtual void restart(double /*t*/, double* /*y*/, double* /*yp*/, const int* /*roots_found*/) {}
+  // Times where the problem's inputs are not smooth; the integrator stops and restarts there.
+  virtual std::vector<double> breakpoints() const { return {}; }
+  // Called after every accepted step with the step's solution.
+  virtual void after_step(double /*t*/, const double* /*y*/) {}
+};
+
+}  // namespace mbdae

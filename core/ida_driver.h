@@ -1,0 +1,47 @@
+// SUNDIALS IDA on a DaeProblem with the SUNLinSol_KLU sparse direct solver.
+//
+// Integration runs in one-step mode; output samples are interpolated from IDA's history
+// (IDAGetDky), so sampling never shortens a step. Breakpoints are hit exactly with a stop time;
+// events (sign changes of the problem's switching functions) are located by IDA's root finding.
+// At both, the problem restarts itself (new modes, consistent y') and IDA is re-initialized.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/dae_problem.h"
+
+namespace mbdae {
+
+struct IdaOptions {
+  double t0 = 0, t1 = 1;
+  double rtol = 1e-6, atol = 1e-8;
+  double output_step = 0.01;  // sample spacing (0: only t0 and t1)
+  double max_step = 0;        // 0: no limit
+  double initial_step = 0;    // 0: IDA's own choice
+  int max_order = 5;
+  long max_steps = 2000000;
+  double nonlinear_convergence = 0.33;  // IDA's epcon
+};
+
+struct IdaStats {
+  long steps = 0, residual_evals = 0, jacobian_evals = 0, linear_setups = 0;
+  long error_test_failures = 0, nonlinear_iterations = 0, nonlinear_failures = 0;
+  long restarts = 0;
+  std::vector<double> event_times;      // located switching events
+  std::vector<double> breakpoint_times;  // stops at input discontinuities
+  double cpu_seconds = 0;
+  double last_step = 0;
+  double t_reached = 0;
+  bool ok = true;
+  std::string status = "ok";  // or "integration_failed"
+  std::string message;
+};
+
+// `output(t, y, yp)` receives each sample; returning false stops the run early.
+IdaStats integrate(DaeProblem& problem, const IdaOptions& options, std::vector<double>& y,
+                   std::vector<double>& yp,
+                   const std::function<bool(double, const double*, const double*)>& output);
+
+}  // namespace mbdae

@@ -1,0 +1,42 @@
+// Sparse LU by SuiteSparse KLU: symbolic analysis once per pattern, numeric factorization
+// (klu_factor) the first time and klu_refactor (same pivot order) afterwards, falling back to a
+// fresh factorization when the reused pivots become poor.
+#pragma once
+
+#include <klu.h>
+
+#include <vector>
+
+#include "core/sparse_assembler.h"
+
+namespace mbdae {
+
+class KluSolver {
+ public:
+  KluSolver();
+  ~KluSolver();
+  KluSolver(const KluSolver&) = delete;
+  KluSolver& operator=(const KluSolver&) = delete;
+
+  // Symbolic analysis of the pattern (kept until analyze is called again).
+  bool analyze(const CscPattern& pattern);
+  // Numeric factorization of values on the analyzed pattern. False if singular.
+  bool factor(const double* values);
+  // Solves A x = b in place.
+  bool solve(double* b);
+  // Reciprocal condition estimate of the last factorization.
+  double rcond();
+  int factorizations() const { return factorizations_; }
+  int status() const { return common_.status; }
+
+ private:
+  void free_numeric();
+  klu_common common_;
+  klu_symbolic* symbolic_ = nullptr;
+  klu_numeric* numeric_ = nullptr;
+  CscPattern pattern_;
+  std::vector<double> values_;
+  int factorizations_ = 0;
+};
+
+}  // namespace mbdae

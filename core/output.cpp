@@ -1,0 +1,65 @@
+#include "core/output.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace mbdae {
+
+CsvWriter::~CsvWriter() {
+  if (file_) close();
+}
+
+void CsvWriter::open(const std::string& path, const std::vector<std::string>& columns) {
+  path_ = path;
+  columns_ = columns.size();
+  file_ = std::fopen((path + ".partial").c_str(), "w");
+  if (!file_) throw std::runtime_error("cannot write " + path + ".partial");
+  for (size_t k = 0; k < columns.size(); ++k)
+    std::fprintf(file_, "%s%s", k ? "," : "", columns[k].c_str());
+  std::fputc('\n', file_);
+}
+
+void CsvWriter::row(const double* v) {
+  for (size_t k = 0; k < columns_; ++k) std::fprintf(file_, "%s%.15g", k ? "," : "", v[k]);
+  std::fputc('\n', file_);
+  ++rows_;
+}
+
+void CsvWriter::flush() {
+  if (file_) std::fflush(file_);
+}
+
+void CsvWriter::close() {
+  if (!file_) return;
+  std::fclose(file_);
+  file_ = nullptr;
+  std::rename((path_ + ".partial").c_str(), path_.c_str());
+}
+
+void write_json_file(const std::string& path, const nlohmann::ordered_json& j) {
+  const std::string tmp = path + ".partial";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+    out << j.dump(2) << "\n";
+    if (!out) throw std::runtime_error("error writing " + tmp);
+  }
+  std::rename(tmp.c_str(), path.c_str());
+}
+
+void prepare_output_folder(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (!std::filesystem::is_directory(dir))
+    throw std::runtime_error("output folder '" + dir + "' cannot be created");
+  const std::string probe = dir + "/.mbdae_write_test";
+  std::FILE* f = std::fopen(probe.c_str(), "w");
+  if (!f) throw std::runtime_error("output folder '" + dir + "' is not writable");
+  std::fclose(f);
+  std::remove(probe.c_str());
+}
+
+}  // namespace mbdae

@@ -1,0 +1,58 @@
+#include "core/sparse_assembler.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace mbdae {
+
+void SparseAssembler::begin_pattern(int rows, int cols) {
+  recording_ = true;
+  trows_.clear();
+  tcols_.clear();
+  pattern_ = CscPattern{};
+  pattern_.rows = rows;
+  pattern_.cols = cols;
+}
+
+void SparseAssembler::finalize() {
+  const size_t n = trows_.size();
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return tcols_[a] != tcols_[b] ? tcols_[a] < tcols_[b] : trows_[a] < trows_[b];
+  });
+  slot_.assign(n, 0);
+  pattern_.colptr.assign(pattern_.cols + 1, 0);
+  pattern_.rowind.clear();
+  int last_r = -1, last_c = -1;
+  for (size_t k = 0; k < n; ++k) {
+    const int i = order[k];
+    if (trows_[i] != last_r || tcols_[i] != last_c) {
+      pattern_.rowind.push_back(trows_[i]);
+      pattern_.colptr[tcols_[i] + 1]++;
+      last_r = trows_[i];
+      last_c = tcols_[i];
+    }
+    slot_[i] = static_cast<int>(pattern_.rowind.size()) - 1;
+  }
+  for (int c = 0; c < pattern_.cols; ++c) pattern_.colptr[c + 1] += pattern_.colptr[c];
+  trows_.clear();
+  tcols_.clear();
+  trows_.shrink_to_fit();
+  tcols_.shrink_to_fit();
+  recording_ = false;
+}
+
+void SparseAssembler::begin_values(double* values) {
+  values_ = values;
+  cursor_ = 0;
+  std::fill(values, values + pattern_.nnz(), 0.0);
+}
+
+void csc_multiply(const CscPattern& p, const double* values, const double* x, double* y) {
+  std::fill(y, y + p.rows, 0.0);
+  for (int c = 0; c < p.cols; ++c)
+    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) y[p.rowind[k]] += values[k] * x[c];
+}
+
+}  // namespace mbdae

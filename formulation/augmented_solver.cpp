@@ -1,0 +1,109 @@
+#include "formulation/augmented_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "formulation/mechanics.h"
+
+namespace mbdae {
+
+AugmentedSolver::AugmentedSolver(const System& sys)
+    : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()) {
+  const int n = nq_ + nc_;
+  asm_.begin_pattern(n, n);
+  assemble(sys.q0.data(), true);
+  asm_.finalize();
+  klu_.analyze(asm_.pattern());
+  values_.resize(asm_.pattern().nnz());
+  rhs_.resize(n);
+  work_.resize(n);
+  work2_.resize(n);
+}
+
+void AugmentedSolver::assemble(const double* q, bool with_mass) {
+  // The same add() sequence for both: the weight pattern equals the mass pattern.
+  if (with_mass)
+    assemble_mass(sys_, q, 1.0, 0, 0, asm_);
+  else
+    assemble_weights(sys_, 1.0, 1.0, 0, 0, asm_);
+  assemble_constraint_jacobian(sys_, offsets_, q, 1.0, nq_, 0, 0, nq_, asm_);
+}
+
+bool AugmentedSolver::accelerations(const std::vector<char>& modes, const double* q,
+                                    const double* v, double t, double* a, double* lambda) {
+  asm_.begin_values(values_.data());
+  assemble(q, true);
+  if (!klu_.factor(values_.data())) return false;
+  generalized_forces(sys_, modes, q, v, t, rhs_.data());
+  constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
+  if (!klu_.solve(rhs_.data())) return false;
+  std::copy(rhs_.begin(), rhs_.begin() + nq_, a);
+  if (lambda) std::copy(rhs_.begin() + nq_, rhs_.end(), lambda);
+  return std::all_of(rhs_.begin(), rhs_.end(), [](double x) { return std::isfinite(x); });
+}
+
+bool AugmentedSolver::velocities(const double* q, double t, double* v) {
+  // [I Phi_q^T; Phi_q 0] [dv; mu] = [0; -Phi_t - Phi_q v]
+  asm_.begin_values(values_.data());
+  assemble(q, false);
+  if (!klu_.factor(values_.data())) return false;
+  std::fill(rhs_.begin(), rhs_.end(), 0.0);
+  constraint_rates(sys_, offsets_, q, v, t, rhs_.data() + nq_, nullptr);
+  constraint_jacobian_times(sys_, offsets_, q, v, work_.data());
+  for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -rhs_[nq_ + i] - work_[i];
+  if (!klu_.solve(rhs_.data())) return false;
+  for (int i = 0; i < nq_; ++i) v[i] += rhs_[i];
+  return true;
+}
+
+PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, int max_iter) {
+  PositionSolveResult res;
+  std::vector<double>& phi = work_;
+  constraint_values(sys_, offsets_, q, t, phi.data());
+  double norm = max_abs(phi.data(), nc_);
+  std::vector<double> trial(q, q + nq_);
+  for (res.iterations = 0; res.iterations < max_iter && norm > tol; ++res.iterations) {
+    // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi].
+    asm_.begin_values(values_.data());
+    assemble(q, false);
+    if (!klu_.factor(values_.data())) break;
+    std::fill(rhs_.begin(), rhs_.begin() + nq_, 0.0);
+    for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -phi[i];
+    if (!klu_.solve(rhs_.data())) break;
+    // Backtracking line search on max |Phi|.
+    double alpha = 1.0, trial_norm = norm;
+    for (int ls = 0; ls < 30; ++ls, alpha *= 0.5) {
+      for (int i = 0; i < nq_; ++i) trial[i] = q[i] + alpha * rhs_[i];
+      constraint_values(sys_, offsets_, trial.data(), t, work2_.data());
+      trial_norm = max_abs(work2_.data(), nc_);
+      if (std::isfinite(trial_norm) && trial_norm < (1.0 - 1e-4 * alpha) * norm) break;
+    }
+    if (!(trial_norm < norm)) break;
+    std::copy(trial.begin(), trial.end(), q);
+    std::copy(work2_.begin(), work2_.begin() + nc_, phi.begin());
+    norm = trial_norm;
+  }
+  res.residual = norm;
+  res.converged = norm <= tol;
+  if (!res.converged) {
+    // Name the most violated constraint equations.
+    std::vector<int> rows(nc_);
+    std::iota(rows.begin(), rows.end(), 0);
+    const int k = std::min(3, nc_);
+    std::partial_sort(rows.begin(), rows.begin() + k, rows.end(),
+                      [&](int a, int b) { return std::fabs(phi[a]) > std::fabs(phi[b]); });
+    std::ostringstream os;
+    for (int i = 0; i < k; ++i) {
+      const int r = rows[i];
+      const int c = static_cast<int>(std::upper_bound(offsets_.begin(), offsets_.end(), r) -
+                                     offsets_.begin()) - 1;
+      os << (i ? "; " : "") << sys_.constraints[c].label << " = " << phi[r];
+    }
+    res.worst = os.str();
+  }
+  return res;
+}
+
+}  // namespace mbdae

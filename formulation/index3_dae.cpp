@@ -1,0 +1,150 @@
+#include "formulation/index3_dae.h"
+
+#include <cmath>
+
+#include "core/errors.h"
+#include "formulation/mechanics.h"
+
+namespace mbdae {
+
+Index3Dae::Index3Dae(const System& sys, double constraint_scale)
+    : sys_(sys),
+      offsets_(constraint_offsets(sys)),
+      nq_(sys.nq()),
+      nc_(offsets_.back()),
+      scale_(constraint_scale),
+      aug_(sys) {
+  modes = initial_modes(sys, sys.q0.data(), 0.0);
+  for (size_t k = 0; k < sys.forces.size(); ++k)
+    if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
+  work_.resize(size());
+  // Record the Jacobian pattern once.
+  std::vector<double> y(size(), 0.0), yp(size(), 0.0);
+  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
+  asm_.begin_pattern(size(), size());
+  assemble(0.0, 1.0, y.data(), yp.data());
+  asm_.finalize();
+}
+
+int Index3Dae::residual(double t, const double* y, const double* yp, double* r) {
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
+  double* f2 = r + nq_;
+  mass_times(sys_, q, yp + nq_, f2);
+  generalized_forces(sys_, modes, q, v, t, work_.data());
+  for (int i = 0; i < nq_; ++i) f2[i] -= work_[i];
+  add_constraint_forces(sys_, offsets_, q, lambda, f2);
+  double* f3 = r + 2 * nq_;
+  constraint_values(sys_, offsets_, q, t, f3);
+  for (int i = 0; i < nc_; ++i) f3[i] *= scale_;
+  for (int i = 0; i < size(); ++i)
+    if (!std::isfinite(r[i])) return 1;  // recoverable: IDA retries with a smaller step
+  return 0;
+}
+
+void Index3Dae::assemble(double t, double cj, const double* y, const double* yp) {
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  const int rq = 0, rv = nq_, rl = 2 * nq_;  // row blocks
+  const int cq = 0, cv = nq_, cl = 2 * nq_;  // column blocks
+  for (int i = 0; i < nq_; ++i) {
+    asm_.add(rq + i, cq + i, cj);
+    asm_.add(rq + i, cv + i, -1.0);
+  }
+  assemble_mass(sys_, q, cj, rv, cv, asm_);
+  assemble_inertia_derivatives(sys_, q, v, yp + nq_, rv, cq, cv, asm_);
+  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, asm_);
+  assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, asm_);
+  assemble_constraint_jacobian(sys_, offsets_, q, scale_, rl, cq, rv, cl, asm_);
+}
+
+int Index3Dae::jacobian(double t, double cj, const double* y, const double* yp, double* values) {
+  asm_.begin_values(values);
+  assemble(t, cj, y, yp);
+  return 0;
+}
+
+void Index3Dae::error_test_mask(double* id) const {
+  for (int i = 0; i < size(); ++i) id[i] = i < nq_ ? 1.0 : 0.0;
+}
+
+std::string Index3Dae::component_name(int i) const {
+  static const char* names[7] = {"x", "y", "z", "e0", "e1", "e2", "e3"};
+  if (i < 2 * nq_) {
+    const int k = i % nq_;
+    return std::string(i < nq_ ? "" : "velocity of ") + sys_.bodies[k / 7].name + "." + names[k % 7];
+  }
+  const int row = i - 2 * nq_;
+  for (size_t c = 0; c < sys_.constraints.size(); ++c)
+    if (row < offsets_[c + 1]) return "multiplier of " + sys_.constraints[c].label;
+  return "y[" + std::to_string(i) + "]";
+}
+
+void Index3Dae::switches(double t, const double* y, double* g) {
+  for (size_t k = 0; k < switch_forces_.size(); ++k) {
+    const Force& f = sys_.forces[switch_forces_[k]];
+    g[k] = force_switch_value(f, gather(y, f.bi, f.bj), t);
+  }
+}
+
+void Index3Dae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
+  double* q = y.data();
+  double* v = y.data() + nq_;
+  const PositionSolveResult pr = aug_.positions(q, t, 1e-12);
+  if (!pr.converged)
+    throw SolveError("inconsistent_initial_state",
+                     "initial positions violate the constraints (max " + std::to_string(pr.residual) +
+                         "): " + pr.worst);
+  if (!aug_.velocities(q, t, v)) throw SolveError("singular", "velocity projection is singular");
+  std::fill(yp.begin(), yp.end(), 0.0);
+  std::copy(v, v + nq_, yp.begin());
+  if (!aug_.accelerations(modes, q, v, t, yp.data() + nq_, y.data() + 2 * nq_))
+    throw SolveError("singular",
+                     "the augmented mass matrix is singular at t = " + std::to_string(t) +
+                         " (redundant constraints or an unconstrained massless body)");
+}
+
+void Index3Dae::restart(double t, double* y, double* yp, const int* roots) {
+  // New modes: flip the switches that crossed zero; at breakpoints, re-evaluate all from signs.
+  for (size_t k = 0; k < switch_forces_.size(); ++k) {
+    const int f = switch_forces_[k];
+    if (roots) {
+      if (roots[k] != 0) modes[f] = roots[k] > 0;
+    } else {
+      const Force& force = sys_.forces[f];
+      modes[f] = force_switch_value(force, gather(y, force.bi, force.bj), t) > 0;
+    }
+  }
+  std::vector<double> yy(y, y + size()), yyp(yp, yp + size());
+  consistent_initial_values(t, yy, yyp);
+  std::copy(yy.begin(), yy.end(), y);
+  std::copy(yyp.begin(), yyp.end(), yp);
+}
+
+void Index3Dae::after_step(double t, const double* y) {
+  constraint_values(sys_, offsets_, y, t, work_.data());
+  max_position_violation = std::fmax(max_position_violation, max_abs(work_.data(), nc_));
+  for (int b = 0; b < sys_.num_bodies(); ++b) {
+    const double n = Eigen::Map<const Vec4>(y + 7 * b + 3).norm();
+    max_norm_drift = std::fmax(max_norm_drift, std::fabs(n - 1.0));
+  }
+}
+
+double Index3Dae::consistent_output(double t, const double* y, std::vector<double>& q,
+                                    std::vector<double>& v, std::vector<double>& a) {
+  q.assign(y, y + nq_);
+  v.assign(y + nq_, y + 2 * nq_);
+  a.resize(nq_);
+  std::vector<double> phi(nc_);
+  constraint_values(sys_, offsets_, q.data(), t, phi.data());
+  const double violation = max_abs(phi.data(), nc_);
+  aug_.positions(q.data(), t, 1e-14, 5);
+  aug_.velocities(q.data(), t, v.data());
+  aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+  return violation;
+}
+
+}  // namespace mbdae

@@ -1,0 +1,64 @@
+// The index-3 DAE of a multibody system in absolute coordinates, for IDA:
+//   y = [q, v, lambda],  y' = [q', v', lambda'] (lambda' unused)
+//   F1 = q' - v                                  = 0
+//   F2 = M(q) v' + Phi_q^T lambda - Q(q, v, t)   = 0
+//   F3 = s Phi(q, t)                             = 0
+// Only q is in the local error test (v and lambda are left out, IDASetId + IDASetSuppressAlg).
+// The constraint rows are scaled by s = m_ref / h_ref^2 so that they are of the size of the
+// cj^2 M rows of the Newton matrix at the typical step h_ref.
+// The Jacobian dF/dy + cj dF/dy' is exact: it includes d(M v')/dq, the gyroscopic derivatives,
+// the applied forces' derivatives and sum_k lambda_k d2Phi_k/dq2.
+#pragma once
+
+#include <vector>
+
+#include "core/dae_problem.h"
+#include "formulation/augmented_solver.h"
+#include "formulation/system.h"
+
+namespace mbdae {
+
+class Index3Dae : public DaeProblem {
+ public:
+  explicit Index3Dae(const System& sys, double constraint_scale = 1.0);
+
+  int size() const override { return 2 * nq_ + nc_; }
+  const CscPattern& jacobian_pattern() override { return asm_.pattern(); }
+  int residual(double t, const double* y, const double* yp, double* r) override;
+  int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
+  void error_test_mask(double* id) const override;
+  std::string component_name(int i) const override;
+  int num_switches() const override { return static_cast<int>(switch_forces_.size()); }
+  void switches(double t, const double* y, double* g) override;
+  void restart(double t, double* y, double* yp, const int* roots_found) override;
+  std::vector<double> breakpoints() const override { return sys_.breakpoints(); }
+  void after_step(double t, const double* y) override;
+
+  // Consistent initial values at rest or from given q, v: solves accelerations and multipliers.
+  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
+  // Projects an interpolated (q, v) onto the constraint manifold (for output), then computes
+  // accelerations. Returns the position violation before projection.
+  double consistent_output(double t, const double* y, std::vector<double>& q,
+                           std::vector<double>& v, std::vector<double>& a);
+
+  std::vector<char> modes;         // per force: wheel in contact
+  double max_position_violation = 0;  // over accepted steps (integrator's own solution)
+  double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
+  int nq() const { return nq_; }
+  int nc() const { return nc_; }
+  const System& system() const { return sys_; }
+  AugmentedSolver& augmented() { return aug_; }
+
+ private:
+  void assemble(double t, double cj, const double* y, const double* yp);
+  const System& sys_;
+  std::vector<int> offsets_;
+  int nq_, nc_;
+  double scale_;
+  std::vector<int> switch_forces_;
+  SparseAssembler asm_;
+  AugmentedSolver aug_;
+  std::vector<double> work_;
+};
+
+}  // namespace mbdae

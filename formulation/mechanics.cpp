@@ -1,0 +1,233 @@
+#include "formulation/mechanics.h"
+
+#include <cmath>
+
+namespace mbdae {
+namespace {
+
+// Global index of local coordinate l of a constraint between bodies bi, bj (or -1).
+inline int global_index(int bi, int bj, int l) {
+  const int b = l < 7 ? bi : bj;
+  return b < 0 ? -1 : 7 * b + (l % 7);
+}
+
+// Constraint types whose Hessian has position (r) entries.
+inline bool hessian_touches_r(const Constraint& c) {
+  return c.type == Constraint::Type::kDot2 || c.type == Constraint::Type::kDistance ||
+         (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
+}
+
+inline Vec4 p_of(const double* q, int b) { return Eigen::Map<const Vec4>(q + 7 * b + 3); }
+
+// Adds a local 14 x 14 block (rows and columns both local to bodies bi, bj).
+void add_local_block(int bi, int bj, const Mat14& m, int row0, int col0, bool with_r,
+                     SparseAssembler& a) {
+  for (int c = 0; c < 14; ++c) {
+    const int gc = global_index(bi, bj, c);
+    if (gc < 0 || (!with_r && c % 7 < 3)) continue;
+    for (int r = 0; r < 14; ++r) {
+      const int gr = global_index(bi, bj, r);
+      if (gr < 0 || (!with_r && r % 7 < 3)) continue;
+      a.add(row0 + gr, col0 + gc, m(r, c));
+    }
+  }
+}
+}  // namespace
+
+std::vector<int> constraint_offsets(const System& sys) {
+  std::vector<int> off;
+  int n = 0;
+  for (const auto& c : sys.constraints) {
+    off.push_back(n);
+    n += c.rows();
+  }
+  off.push_back(n);
+  return off;
+}
+
+std::vector<char> initial_modes(const System& sys, const double* q, double t) {
+  std::vector<char> modes(sys.forces.size(), 1);
+  for (size_t k = 0; k < sys.forces.size(); ++k) {
+    const Force& f = sys.forces[k];
+    if (force_has_switch(f)) modes[k] = force_switch_value(f, gather(q, f.bi, f.bj), t) > 0;
+  }
+  return modes;
+}
+
+void mass_times(const System& sys, const double* q, const double* acc, double* out) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const SystemBody& body = sys.bodies[b];
+    const double* a = acc + 7 * b;
+    double* o = out + 7 * b;
+    for (int k = 0; k < 3; ++k) o[k] = body.mass * a[k];
+    const Mat34 l = L_matrix(p_of(q, b));
+    Eigen::Map<Vec4>(o + 3) = 4.0 * l.transpose() * (body.inertia * (l * Eigen::Map<const Vec4>(a + 3)));
+  }
+}
+
+void generalized_forces(const System& sys, const std::vector<char>& modes, const double* q,
+                        const double* v, double t, double* out) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const SystemBody& body = sys.bodies[b];
+    double* o = out + 7 * b;
+    for (int k = 0; k < 3; ++k) o[k] = body.mass * sys.gravity[k];
+    const Vec4 p = p_of(q, b), pd = p_of(v, b);
+    Eigen::Map<Vec4>(o + 3) =
+        -8.0 * L_matrix(pd).transpose() * (body.inertia * (L_matrix(p) * pd));
+  }
+  for (size_t k = 0; k < sys.forces.size(); ++k) {
+    const Force& f = sys.forces[k];
+    Vec14 ql = Vec14::Zero();
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr);
+    for (int l = 0; l < 14; ++l) {
+      const int g = global_index(f.bi, f.bj, l);
+      if (g >= 0) out[g] += ql[l];
+    }
+  }
+}
+
+void constraint_values(const System& sys, const std::vector<int>& off, const double* q, double t,
+                       double* phi) {
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_value(c, gather(q, c.bi, c.bj), t, phi + off[k]);
+  }
+}
+
+void constraint_rates(const System& sys, const std::vector<int>& off, const double* q,
+                      const double* v, double t, double* phi_t, double* gamma) {
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const LocalState s = gather(q, c.bi, c.bj);
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    double pt[3], ptt[3];
+    constraint_time_derivatives(c, t, pt, ptt);
+    for (int r = 0; r < c.rows(); ++r) {
+      double w[3] = {0, 0, 0};
+      w[r] = 1.0;
+      Mat14 h = Mat14::Zero();
+      constraint_hessian(c, s, w, h);
+      if (phi_t) phi_t[off[k] + r] = pt[r];
+      if (gamma) gamma[off[k] + r] = -vl.dot(h * vl) - ptt[r];
+    }
+  }
+}
+
+void add_constraint_forces(const System& sys, const std::vector<int>& off, const double* q,
+                           const double* lambda, double* out) {
+  Row14 rows[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
+    for (int r = 0; r < c.rows(); ++r) {
+      const double lam = lambda[off[k] + r];
+      for (int l = 0; l < 14; ++l) {
+        const int g = global_index(c.bi, c.bj, l);
+        if (g >= 0) out[g] += rows[r](l) * lam;
+      }
+    }
+  }
+}
+
+void constraint_jacobian_times(const System& sys, const std::vector<int>& off, const double* q,
+                               const double* v, double* out) {
+  Row14 rows[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[r].dot(vl);
+  }
+}
+
+double max_abs(const double* x, int n) {
+  double m = 0;
+  for (int i = 0; i < n; ++i) m = std::fmax(m, std::fabs(x[i]));
+  return m;
+}
+
+void assemble_mass(const System& sys, const double* q, double scale, int row0, int col0,
+                   SparseAssembler& a) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const SystemBody& body = sys.bodies[b];
+    const int o = 7 * b;
+    for (int k = 0; k < 3; ++k) a.add(row0 + o + k, col0 + o + k, scale * body.mass);
+    const Mat34 l = L_matrix(p_of(q, b));
+    const Mat4 m = 4.0 * scale * l.transpose() * body.inertia * l;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) a.add(row0 + o + 3 + r, col0 + o + 3 + c, m(r, c));
+  }
+}
+
+void assemble_weights(const System& sys, double wr, double wp, int row0, int col0,
+                      SparseAssembler& a) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const int o = 7 * b;
+    for (int k = 0; k < 3; ++k) a.add(row0 + o + k, col0 + o + k, wr);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) a.add(row0 + o + 3 + r, col0 + o + 3 + c, r == c ? wp : 0.0);
+  }
+}
+
+void assemble_inertia_derivatives(const System& sys, const double* q, const double* v,
+                                  const double* acc, int row0, int colq, int colv,
+                                  SparseAssembler& a) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const Mat3& j = sys.bodies[b].inertia;
+    const Vec4 p = p_of(q, b), pd = p_of(v, b), pdd = p_of(acc, b);
+    const Mat34 l = L_matrix(p), ld = L_matrix(pd);
+    // d(4 L^T J L a)/dp = 4 [P(J L a) - L^T J L(a)];  d(8 L(p')^T J L p')/dp = -8 L(p')^T J L(p').
+    const Mat4 dq = 4.0 * (P_matrix(j * (l * pdd)) - l.transpose() * j * L_matrix(pdd)) -
+                    8.0 * ld.transpose() * j * ld;
+    // d(8 L(p')^T J L p')/dp' = 8 [P(J L p') + L(p')^T J L].
+    const Mat4 dv = 8.0 * (P_matrix(j * (l * pd)) + ld.transpose() * j * l);
+    const int o = 7 * b + 3;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) {
+        a.add(row0 + o + r, colq + o + c, dq(r, c));
+        if (colv >= 0) a.add(row0 + o + r, colv + o + c, dv(r, c));
+      }
+  }
+}
+
+void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
+                                const double* q, const double* v, double t, int row0, int colq,
+                                int colv, SparseAssembler& a) {
+  for (size_t k = 0; k < sys.forces.size(); ++k) {
+    const Force& f = sys.forces[k];
+    Vec14 ql = Vec14::Zero();
+    Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+    add_local_block(f.bi, f.bj, -dx, row0, colq, true, a);
+    if (colv >= 0) add_local_block(f.bi, f.bj, -dv, row0, colv, true, a);
+  }
+}
+
+void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off,
+                                  const double* q, double scale, int row0, int col0, int row0t,
+                                  int col0t, SparseAssembler& a) {
+  Row14 rows[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
+    for (int r = 0; r < c.rows(); ++r)
+      for (int l = 0; l < 14; ++l) {
+        const int g = global_index(c.bi, c.bj, l);
+        if (g < 0) continue;
+        if (row0 >= 0) a.add(row0 + off[k] + r, col0 + g, scale * rows[r](l));
+        if (row0t >= 0) a.add(row0t + g, col0t + off[k] + r, rows[r](l));
+      }
+  }
+}
+
+void assemble_constraint_hessian(const System& sys, const std::vector<int>& off, const double* q,
+                                 const double* lambda, int row0, int col0, SparseAssembler& a) {
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    Mat14 h = Mat14::Zero();
+    constraint_hessian(c, gather(q, c.bi, c.bj), lambda + off[k], h);
+    add_local_block(c.bi, c.bj, h, row0, col0, hessian_touches_r(c), a);
+  }
+}
+
+}  // namespace mbdae

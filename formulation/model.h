@@ -1,0 +1,116 @@
+// The mechanism as a user describes it (names, joint chains, points), before it is turned
+// into Cartesian coordinates and constraints by build_system(). Plain data: the scene loader
+// (cases/) fills it, tests build it directly.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/time_function.h"
+#include "formulation/euler_parameters.h"
+
+namespace mbdae {
+
+// Where a value came from in a scene file, for error messages.
+struct SourceLocation {
+  std::string file;
+  int line = 0;  // 1-based; 0 if unknown
+};
+
+inline constexpr const char* kGround = "ground";
+
+struct BodySpec {
+  std::string name;
+  double mass = 0;
+  Vec3 com = Vec3::Zero();              // in the body frame
+  Mat3 inertia = Mat3::Zero();          // about the centre of mass, body axes
+  std::map<std::string, Vec3> points;   // named points in the body frame
+  SourceLocation where;
+};
+
+// One elementary joint of a Robotran chain: R1 R2 R3 rotate about the current x, y, z axis;
+// T1 T2 T3 translate along it.
+struct ElementaryJoint {
+  bool rotation = true;
+  int axis = 0;            // 0, 1, 2
+  std::string coordinate;  // name of its joint coordinate
+};
+
+struct JointSpec {
+  std::string name, parent, child;
+  std::string anchor_point;            // a named point of the parent, or empty:
+  Vec3 anchor = Vec3::Zero();          // anchor in the parent frame (used if no name)
+  std::vector<ElementaryJoint> chain;  // empty chain = weld
+  SourceLocation where;
+};
+
+struct CoordinateSpec {
+  enum class Mode { kFree, kLocked, kDriven };
+  std::string name;
+  double initial = 0;  // SI units (rad or m); initial guess for assembly
+  Mode mode = Mode::kFree;
+  TimeFunction drive;  // for kDriven
+  SourceLocation where;
+};
+
+// Loop-closure (cut) constraint between two bodies; "ground" is allowed as a body.
+struct CutSpec {
+  enum class Type { kBall, kRevolute, kUniversal, kPrismatic, kWeld, kDistance };
+  std::string name;
+  Type type = Type::kBall;
+  std::string body1, point1, body2, point2;
+  Vec3 axis1 = Vec3::UnitZ(), axis2 = Vec3::UnitZ();  // body-frame axes (revolute: axis; ...)
+  double distance = 0;                                 // kDistance
+  SourceLocation where;
+};
+
+struct ForceSpec {
+  enum class Type { kSpringDamper, kPointForce, kWheelContact, kUser };
+  std::string name;
+  Type type = Type::kSpringDamper;
+  std::string body1, point1, body2, point2;
+  // Spring-damper: tension = stiffness (length - free_length) + damping d(length)/dt.
+  double stiffness = 0, damping = 0, free_length = 0;
+  // Point force: world components as functions of time.
+  TimeFunction fx, fy, fz;
+  // Wheel contact: vertical force max(0, stiffness e), e = radius cos(camber) - (z - ground(t)),
+  // at point1 of body1; axis = wheel spin axis in the body frame.
+  double radius = 0;
+  Vec3 axis = Vec3::UnitY();
+  TimeFunction ground;
+  // User force law: registered name and numeric parameters.
+  std::string law;
+  std::map<std::string, double> parameters;
+  SourceLocation where;
+};
+
+struct SensorSpec {
+  enum class Type {
+    kPosition, kVelocity, kAcceleration,  // of a body point, world component
+    kAxis,                                // world component of a body-fixed unit vector
+    kCoordinate, kCoordinateRate,         // joint coordinate and its rate
+    kForceLength, kForceValue,            // length / tension of a force element
+    kExpression                           // derived from other sensors
+  };
+  std::string name;
+  Type type = Type::kPosition;
+  std::string body, point, target;  // target: coordinate or force name
+  Vec3 axis = Vec3::UnitX();
+  int component = 0;
+  std::string expression;
+  SourceLocation where;
+};
+
+struct Model {
+  std::string name;
+  Vec3 gravity = Vec3(0, 0, -9.81);
+  std::vector<BodySpec> bodies;
+  std::vector<JointSpec> joints;
+  std::vector<CutSpec> cuts;
+  std::vector<ForceSpec> forces;
+  std::vector<SensorSpec> sensors;
+  std::map<std::string, CoordinateSpec> coordinates;
+};
+
+}  // namespace mbdae

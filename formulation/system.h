@@ -1,0 +1,104 @@
+// The mechanism in absolute coordinates: what the solvers work on.
+//
+// build_system() turns a Model into moving bodies (each with 7 coordinates: centre of mass r and
+// Euler parameters p), scalar constraint equations, force elements and sensors. Tree joints whose
+// coordinates are all locked (and welds) are not constraints: the child is merged into its parent
+// (a rigid composite; a body merged into ground is not a body at all). Every other joint chain
+// becomes the equivalent Cartesian constraints, plus a coordinate constraint for each locked or
+// driven coordinate of the chain.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/expression.h"
+#include "formulation/constraints.h"
+#include "formulation/model.h"
+
+namespace mbdae {
+
+struct SystemBody {
+  std::string name;  // the host's name (its merged bodies listed in `merged`)
+  double mass = 0;
+  Mat3 inertia = Mat3::Zero();  // about the centre of mass, in the body's axes
+  std::vector<std::string> merged;
+};
+
+// Where an original body of the model lives: on host body `body` (-1 = ground), with
+// x_local = rotation * x_body + offset (local = host centre-of-mass coordinates, world for ground).
+struct BodyFrame {
+  int body = -1;
+  Mat3 rotation = Mat3::Identity();
+  Vec3 offset = Vec3::Zero();
+  Vec3 local_point(const Vec3& s) const { return rotation * s + offset; }
+  Vec3 local_vector(const Vec3& a) const { return rotation * a; }
+};
+
+// A joint coordinate: measured from the bodies (a function), or constant if its joint was merged.
+struct JointCoordinate {
+  std::string name, joint;
+  bool merged = false;
+  double value_if_merged = 0;
+  CoordinateFunction function;
+  CoordinateSpec spec;
+};
+
+struct UserForceLaw;  // formulation/forces.h
+
+struct Force {
+  ForceSpec::Type type = ForceSpec::Type::kSpringDamper;
+  std::string name;
+  int bi = -1, bj = -1;
+  Vec3 si = Vec3::Zero(), sj = Vec3::Zero();
+  double stiffness = 0, damping = 0, free_length = 0;
+  TimeFunction fx, fy, fz, ground;
+  double radius = 0;
+  Vec3 axis = Vec3::UnitY();  // wheel spin axis in local coordinates
+  const UserForceLaw* law = nullptr;
+  std::vector<double> parameters;
+};
+
+struct Sensor {
+  SensorSpec::Type type = SensorSpec::Type::kPosition;
+  std::string name;
+  int body = -1;
+  Vec3 point = Vec3::Zero(), axis = Vec3::UnitX();
+  int component = 0;
+  int target = -1;  // coordinate or force index
+  Expression expression;
+};
+
+struct System {
+  std::string name;
+  Vec3 gravity = Vec3::Zero();
+  std::vector<SystemBody> bodies;
+  std::map<std::string, BodyFrame> frames;  // every original body (and "ground")
+  std::vector<Constraint> constraints;
+  std::vector<JointCoordinate> coordinates;
+  std::vector<Force> forces;
+  std::vector<Sensor> sensors;
+  std::vector<double> q0;  // initial guess from the joint coordinates' initial values
+
+  int num_bodies() const { return static_cast<int>(bodies.size()); }
+  int nq() const { return 7 * num_bodies(); }
+  int num_constraint_rows() const;
+  int coordinate_index(const std::string& name) const;  // -1 if none
+  int force_index(const std::string& name) const;
+  // Every time at which a driver, force or ground profile is not smooth.
+  std::vector<double> breakpoints() const;
+};
+
+// Throws ModelError (with the scene location) on an inconsistent model.
+System build_system(const Model& model);
+
+// A constraint holding joint coordinate `k` at `value` (for assembly with independent
+// coordinates held, and for equilibrium).
+Constraint hold_constraint(const System& sys, int k, double value);
+
+// The current value of a joint coordinate.
+double coordinate_value(const System& sys, int k, const double* q);
+double coordinate_rate(const System& sys, int k, const double* q, const double* v);
+
+}  // namespace mbdae
