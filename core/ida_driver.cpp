@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <cstdlib>
 #include <ctime>
 #include <numeric>
 #include <sstream>
@@ -120,6 +121,9 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   IDASetMaxNumSteps(mem, o.max_steps);
   IDASetMaxOrd(mem, o.max_order);
   IDASetNonlinConvCoef(mem, o.nonlinear_convergence);
+  // Refresh the Newton matrix whenever cj changes by more than delta_cj: with index-3 rows the
+  // matrix does not scale with cj, and IDA's rescaled old-matrix corrections fail to converge.
+  IDASetDeltaCjLSetup(mem, o.delta_cj);
   if (o.max_step > 0) IDASetMaxStep(mem, o.max_step);
   if (o.initial_step > 0) IDASetInitStep(mem, o.initial_step);
   const int nsw = problem.num_switches();

@@ -23,6 +23,7 @@ struct IdaOptions {
   int max_order = 5;
   long max_steps = 2000000;
   double nonlinear_convergence = 0.33;  // IDA's epcon
+  double delta_cj = 0.01;               // relative change of cj that forces a new Newton matrix
 };
 
 struct IdaStats {

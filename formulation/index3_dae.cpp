@@ -71,6 +71,11 @@ void Index3Dae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ ? 1.0 : 0.0;
 }
 
+void Index3Dae::absolute_tolerances(double atol, double* out) const {
+  for (int i = 0; i < size(); ++i)
+    out[i] = i < nq_ ? atol : (i < 2 * nq_ ? atol * velocity_tolerance_factor : multiplier_tolerance);
+}
+
 std::string Index3Dae::component_name(int i) const {
   static const char* names[7] = {"x", "y", "z", "e0", "e1", "e2", "e3"};
   if (i < 2 * nq_) {

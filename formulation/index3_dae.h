@@ -27,6 +27,12 @@ class Index3Dae : public DaeProblem {
   int residual(double t, const double* y, const double* yp, double* r) override;
   int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
   void error_test_mask(double* id) const override;
+  // Weights of the Newton convergence test: velocities and multipliers are out of the error
+  // test, and their Newton corrections scale like 1/h and 1/h^2 of the position corrections;
+  // their tolerances are widened by velocity_tolerance_factor and multiplier_tolerance.
+  void absolute_tolerances(double atol, double* out) const override;
+  double velocity_tolerance_factor = 1e3;
+  double multiplier_tolerance = 1e3;
   std::string component_name(int i) const override;
   int num_switches() const override { return static_cast<int>(switch_forces_.size()); }
   void switches(double t, const double* y, double* g) override;

@@ -1,1 +1,280 @@
+// Every analytic derivative against central finite differences: constraint gradients and
+// Hessians, applied-force Jacobians, and the full index-3 Newton matrix dF/dy + cj dF/dy'.
 #include <gtest/gtest.h>
+
+#include <random>
+
+#include "formulation/forces.h"
+#include "formulation/index3_dae.h"
+#include "formulation/mechanics.h"
+#include "formulation/system.h"
+#include "formulation/tests/test_models.h"
+
+namespace mbdae {
+namespace {
+
+using testing::add_coordinate;
+using testing::make_body;
+using testing::make_joint;
+
+// A model exercising every constraint and force type: chains R1, R1 R3, R1 R2 R3, T3, T1 R3,
+// R3 T1, weld; cuts of every type; spring-damper, point force, wheel contact, user law.
+Model all_types_model() {
+  Model m;
+  m.name = "all_types";
+  m.bodies.push_back(make_body("a", 2.0, Vec3(0.1, 0.2, -0.3), Vec3(0.3, 0.4, 0.5), Vec3(0.01, 0.02, 0.03)));
+  m.bodies.push_back(make_body("b", 1.5, Vec3(0.0, 0.4, 0.1), Vec3(0.2, 0.1, 0.25)));
+  m.bodies.push_back(make_body("c", 1.0, Vec3(0.2, 0.0, 0.0), Vec3(0.1, 0.1, 0.1)));
+  m.bodies.push_back(make_body("d", 3.0, Vec3(0.0, 0.0, 0.1), Vec3(0.2, 0.3, 0.2)));
+  m.bodies.push_back(make_body("e", 0.5, Vec3(0.1, 0.1, 0.1), Vec3(0.05, 0.04, 0.03)));
+  m.bodies.push_back(make_body("f", 0.7, Vec3(0.0, 0.2, 0.0), Vec3(0.05, 0.06, 0.07)));
+  m.bodies.push_back(make_body("g", 0.9, Vec3(0.0, 0.0, 0.0), Vec3(0.05, 0.06, 0.07)));
+  m.bodies[0].points["p"] = Vec3(0.3, -0.1, 0.2);
+  m.joints.push_back(make_joint("ja", kGround, "a", Vec3(0.1, 0, 1), "R1 ", {"qa"}));
+  m.joints.push_back(make_joint("jb", "a", "b", Vec3(0.2, 0.1, -0.4), "R1 R3 ", {"qb1", "qb2"}));
+  m.joints.push_back(make_joint("jc", "b", "c", Vec3(0, 0.5, 0), "R1 R2 R3 ", {"qc1", "qc2", "qc3"}));
+  m.joints.push_back(make_joint("jd", kGround, "d", Vec3(1, 1, 0), "T3 ", {"qd"}));
+  m.joints.push_back(make_joint("je", "d", "e", Vec3(0.1, 0.2, 0.3), "T1 R3 ", {"qe1", "qe2"}));
+  m.joints.push_back(make_joint("jf", "d", "f", Vec3(-0.1, 0.2, 0.3), "R3 T1 ", {"qf1", "qf2"}));
+  m.joints.push_back(make_joint("jg", "f", "g", Vec3(0.0, 0.1, 0.0), "R2 ", {"qg"}));
+  add_coordinate(m, "qa", 0.3);
+  add_coordinate(m, "qb1", -0.2);
+  add_coordinate(m, "qb2", 0.4);
+  add_coordinate(m, "qc1", 0.1);
+  add_coordinate(m, "qc2", 0.2);
+  add_coordinate(m, "qc3", -0.3);
+  add_coordinate(m, "qd", 0.5);
+  add_coordinate(m, "qe1", 0.05);
+  add_coordinate(m, "qe2", 0.3);
+  add_coordinate(m, "qf1", -0.4);
+  add_coordinate(m, "qf2", 0.07, CoordinateSpec::Mode::kDriven);
+  m.coordinates["qf2"].drive.kind = TimeFunction::Kind::kSine;
+  m.coordinates["qf2"].drive.a = 0.1;
+  m.coordinates["qf2"].drive.b = 2.0;
+  add_coordinate(m, "qg", 0.2, CoordinateSpec::Mode::kDriven);
+  m.coordinates["qg"].drive = TimeFunction::constant(0.2);
+  auto cut = [&](CutSpec::Type t, const std::string& b1, const std::string& b2) {
+    CutSpec c;
+    c.name = "cut" + std::to_string(m.cuts.size());
+    c.type = t;
+    c.body1 = b1;
+    c.body2 = b2;
+    c.axis1 = Vec3(0.3, 0.5, 0.8);
+    c.axis2 = Vec3(-0.2, 0.9, 0.1);
+    c.distance = 0.7;
+    m.cuts.push_back(c);
+  };
+  cut(CutSpec::Type::kBall, "c", "e");
+  cut(CutSpec::Type::kRevolute, "c", "g");
+  cut(CutSpec::Type::kUniversal, "a", "e");
+  cut(CutSpec::Type::kPrismatic, "b", "g");
+  cut(CutSpec::Type::kWeld, kGround, "g");
+  cut(CutSpec::Type::kDistance, "a", "d");
+  ForceSpec s;
+  s.name = "spring";
+  s.type = ForceSpec::Type::kSpringDamper;
+  s.body1 = "a";
+  s.point1 = "p";
+  s.body2 = "c";
+  s.stiffness = 100;
+  s.damping = 3;
+  s.free_length = 0.2;
+  m.forces.push_back(s);
+  ForceSpec p;
+  p.name = "push";
+  p.type = ForceSpec::Type::kPointForce;
+  p.body1 = "b";
+  p.fx = TimeFunction::constant(1.0);
+  p.fz = TimeFunction::constant(-2.0);
+  m.forces.push_back(p);
+  ForceSpec w;
+  w.name = "tyre";
+  w.type = ForceSpec::Type::kWheelContact;
+  w.body1 = "g";
+  w.stiffness = 1000;
+  w.radius = 0.3;
+  w.axis = Vec3(0, 1, 0);
+  w.ground = TimeFunction::constant(0.9);
+  m.forces.push_back(w);
+  ForceSpec u;
+  u.name = "bushing";
+  u.type = ForceSpec::Type::kUser;
+  u.body1 = "e";
+  u.body2 = kGround;
+  u.law = "linear_bushing";
+  u.parameters = {{"stiffness", 50.0}, {"damping", 2.0}};
+  m.forces.push_back(u);
+  ForceSpec s2 = s;
+  s2.name = "spring_ground";
+  s2.body1 = kGround;
+  s2.point1 = "";
+  s2.body2 = "d";
+  m.forces.push_back(s2);
+  return m;
+}
+
+struct RandomState {
+  std::vector<double> q, v, a, lambda;
+};
+RandomState random_state(const System& sys, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  RandomState s;
+  const int nq = sys.nq();
+  s.q = sys.q0;
+  for (int i = 0; i < nq; ++i) s.q[i] += 0.05 * u(gen);
+  for (int b = 0; b < sys.num_bodies(); ++b) Eigen::Map<Vec4>(s.q.data() + 7 * b + 3).normalize();
+  s.v.resize(nq);
+  s.a.resize(nq);
+  for (int i = 0; i < nq; ++i) {
+    s.v[i] = u(gen);
+    s.a[i] = u(gen);
+  }
+  s.lambda.resize(sys.num_constraint_rows());
+  for (auto& l : s.lambda) l = 10 * u(gen);
+  return s;
+}
+
+TEST(JacobianFd, ConstraintGradientsAndHessians) {
+  const System sys = build_system(all_types_model());
+  const RandomState st = random_state(sys, 1);
+  int checked[6] = {0, 0, 0, 0, 0, 0};
+  for (const Constraint& c : sys.constraints) {
+    const LocalState s = gather(st.q.data(), c.bi, c.bj);
+    Vec14 x = Vec14::Zero();
+    x.head<3>() = s.ri;
+    x.segment<4>(3) = s.pi;
+    x.segment<3>(7) = s.rj;
+    x.tail<4>() = s.pj;
+    auto state_of = [&](const Vec14& y) {
+      LocalState t;
+      t.ri = y.head<3>();
+      t.pi = y.segment<4>(3);
+      t.rj = y.segment<3>(7);
+      t.pj = y.tail<4>();
+      return t;
+    };
+    Row14 rows[3];
+    constraint_jacobian(c, s, rows);
+    const double w[3] = {0.7, -1.3, 0.4};
+    Mat14 h = Mat14::Zero();
+    constraint_hessian(c, s, w, h);
+    const double eps = 1e-6;
+    for (int l = 0; l < 14; ++l) {
+      if ((l < 7 && c.bi < 0) || (l >= 7 && c.bj < 0)) continue;
+      Vec14 xp = x, xm = x;
+      xp[l] += eps;
+      xm[l] -= eps;
+      double vp[3], vm[3];
+      constraint_value(c, state_of(xp), 0.3, vp);
+      constraint_value(c, state_of(xm), 0.3, vm);
+      Row14 rp[3], rm[3];
+      constraint_jacobian(c, state_of(xp), rp);
+      constraint_jacobian(c, state_of(xm), rm);
+      Row14 hw = Row14::Zero();
+      for (int r = 0; r < c.rows(); ++r) {
+        const double fd = (vp[r] - vm[r]) / (2 * eps);
+        EXPECT_NEAR(rows[r](l), fd, 1e-6 * (1 + std::fabs(fd))) << c.label << " row " << r << " col " << l;
+        hw += w[r] * (rp[r] - rm[r]) / (2 * eps);
+      }
+      for (int k = 0; k < 14; ++k) {
+        if ((k < 7 && c.bi < 0) || (k >= 7 && c.bj < 0)) continue;
+        EXPECT_NEAR(h(k, l), hw(k), 1e-6 * (1 + std::fabs(hw(k)))) << c.label << " hessian " << k << "," << l;
+      }
+    }
+    checked[static_cast<int>(c.type)]++;
+  }
+  for (int t = 0; t < 6; ++t) EXPECT_GT(checked[t], 0) << "constraint type " << t << " not exercised";
+}
+
+TEST(JacobianFd, ForceJacobians) {
+  const System sys = build_system(all_types_model());
+  const RandomState st = random_state(sys, 2);
+  ASSERT_EQ(sys.forces.size(), 5u);
+  for (const Force& f : sys.forces) {
+    const LocalState x = gather(st.q.data(), f.bi, f.bj), v = gather(st.v.data(), f.bi, f.bj);
+    Vec14 q0 = Vec14::Zero();
+    Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
+    force_eval(f, x, v, 0.2, true, q0, &dx, &dv);
+    EXPECT_GT(q0.norm(), 0) << f.name;
+    auto to_vec = [](const LocalState& s) {
+      Vec14 y;
+      y << s.ri, s.pi, s.rj, s.pj;
+      return y;
+    };
+    auto to_state = [](const Vec14& y) {
+      LocalState t;
+      t.ri = y.head<3>();
+      t.pi = y.segment<4>(3);
+      t.rj = y.segment<3>(7);
+      t.pj = y.tail<4>();
+      return t;
+    };
+    const Vec14 xv = to_vec(x), vv = to_vec(v);
+    const double eps = 1e-6;
+    for (int l = 0; l < 14; ++l) {
+      if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
+      for (int which = 0; which < 2; ++which) {
+        Vec14 p = which ? vv : xv, m = p;
+        p[l] += eps;
+        m[l] -= eps;
+        Vec14 qp = Vec14::Zero(), qm = Vec14::Zero();
+        if (which) {
+          force_eval(f, x, to_state(p), 0.2, true, qp, nullptr, nullptr);
+          force_eval(f, x, to_state(m), 0.2, true, qm, nullptr, nullptr);
+        } else {
+          force_eval(f, to_state(p), v, 0.2, true, qp, nullptr, nullptr);
+          force_eval(f, to_state(m), v, 0.2, true, qm, nullptr, nullptr);
+        }
+        const Vec14 fd = (qp - qm) / (2 * eps);
+        const Mat14& an = which ? dv : dx;
+        for (int k = 0; k < 14; ++k)
+          EXPECT_NEAR(an(k, l), fd(k), 1e-5 * (1 + std::fabs(fd(k))))
+              << f.name << (which ? " dQ/dv " : " dQ/dq ") << k << "," << l;
+      }
+    }
+  }
+}
+
+TEST(JacobianFd, Index3NewtonMatrix) {
+  const System sys = build_system(all_types_model());
+  Index3Dae dae(sys, 7.0);
+  const RandomState st = random_state(sys, 3);
+  const int n = dae.size(), nq = sys.nq();
+  std::vector<double> y(n), yp(n);
+  std::copy(st.q.begin(), st.q.end(), y.begin());
+  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
+  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
+  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
+  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  const double cj = 37.0, t = 0.3;
+  const CscPattern& p = dae.jacobian_pattern();
+  std::vector<double> values(p.nnz());
+  dae.jacobian(t, cj, y.data(), yp.data(), values.data());
+  Eigen::MatrixXd an = Eigen::MatrixXd::Zero(n, n);
+  for (int c = 0; c < n; ++c)
+    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) an(p.rowind[k], c) += values[k];
+  std::vector<double> rp(n), rm(n);
+  const double eps = 1e-6;
+  double worst = 0;
+  for (int c = 0; c < n; ++c) {
+    std::vector<double> yy = y, yyp = yp, ym = y, ymp = yp;
+    yy[c] += eps;
+    yyp[c] += cj * eps;
+    ym[c] -= eps;
+    ymp[c] -= cj * eps;
+    dae.residual(t, yy.data(), yyp.data(), rp.data());
+    dae.residual(t, ym.data(), ymp.data(), rm.data());
+    for (int r = 0; r < n; ++r) {
+      const double fd = (rp[r] - rm[r]) / (2 * eps);
+      const double err = std::fabs(an(r, c) - fd) / (1 + std::fabs(fd));
+      worst = std::max(worst, err);
+      EXPECT_LT(err, 1e-6) << "row " << dae.component_name(r) << " col " << dae.component_name(c)
+                           << " analytic " << an(r, c) << " fd " << fd;
+    }
+  }
+  RecordProperty("worst_relative_error", std::to_string(worst));
+}
+
+}  // namespace
+}  // namespace mbdae
