@@ -22,9 +22,10 @@ class DaeProblem {
   // 1 for components in the local error test, 0 for those left out (algebraic, velocities and
   // multipliers of an index-3 system).
   virtual void error_test_mask(double* id) const = 0;
-  // Absolute tolerance per component given the user's scalar atol.
-  virtual void absolute_tolerances(double atol, double* out) const {
-    for (int i = 0; i < size(); ++i) out[i] = atol;
+  // Weights of the error test and of the Newton convergence test, 1 / tolerance per component,
+  // for the step size h about to be attempted. The default is IDA's own 1/(rtol|y| + atol).
+  virtual void error_weights(double h, const double* y, double rtol, double atol, double* w) const {
+    for (int i = 0; i < size(); ++i) w[i] = 1.0 / (rtol * (y[i] < 0 ? -y[i] : y[i]) + atol);
   }
   virtual std::string component_name(int i) const { return "y[" + std::to_string(i) + "]"; }
 

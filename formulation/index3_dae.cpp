@@ -15,6 +15,7 @@ Index3Dae::Index3Dae(const System& sys, double constraint_scale)
       scale_(constraint_scale),
       aug_(sys) {
   modes = initial_modes(sys, sys.q0.data(), 0.0);
+  for (const auto& b : sys.bodies) mass_scale_ = std::fmax(mass_scale_, b.mass);
   for (size_t k = 0; k < sys.forces.size(); ++k)
     if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
   work_.resize(size());
@@ -71,9 +72,11 @@ void Index3Dae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ ? 1.0 : 0.0;
 }
 
-void Index3Dae::absolute_tolerances(double atol, double* out) const {
-  for (int i = 0; i < size(); ++i)
-    out[i] = i < nq_ ? atol : (i < 2 * nq_ ? atol * velocity_tolerance_factor : multiplier_tolerance);
+void Index3Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
+  const double av = atol / h, al = mass_scale_ * atol / (h * h);
+  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
+  for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
+  for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 
 std::string Index3Dae::component_name(int i) const {

@@ -27,12 +27,11 @@ class Index3Dae : public DaeProblem {
   int residual(double t, const double* y, const double* yp, double* r) override;
   int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
   void error_test_mask(double* id) const override;
-  // Weights of the Newton convergence test: velocities and multipliers are out of the error
-  // test, and their Newton corrections scale like 1/h and 1/h^2 of the position corrections;
-  // their tolerances are widened by velocity_tolerance_factor and multiplier_tolerance.
-  void absolute_tolerances(double atol, double* out) const override;
-  double velocity_tolerance_factor = 1e3;
-  double multiplier_tolerance = 1e3;
+  // Weights of the Newton convergence test. Velocities and multipliers are out of the error
+  // test; rounding in the position-level constraints (eps) reaches them as eps/h and eps/h^2,
+  // so their tolerances are those of the positions divided by h and h^2 (Hairer and Wanner,
+  // Solving ODEs II, VII.3): rtol|v| + atol/h and rtol|lambda| + m_ref atol/h^2.
+  void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
   std::string component_name(int i) const override;
   int num_switches() const override { return static_cast<int>(switch_forces_.size()); }
   void switches(double t, const double* y, double* g) override;
@@ -61,6 +60,7 @@ class Index3Dae : public DaeProblem {
   std::vector<int> offsets_;
   int nq_, nc_;
   double scale_;
+  double mass_scale_ = 1e-3;
   std::vector<int> switch_forces_;
   SparseAssembler asm_;
   AugmentedSolver aug_;

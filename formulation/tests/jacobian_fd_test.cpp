@@ -38,10 +38,10 @@ Model all_types_model() {
   m.joints.push_back(make_joint("jf", "d", "f", Vec3(-0.1, 0.2, 0.3), "R3 T1 ", {"qf1", "qf2"}));
   m.joints.push_back(make_joint("jg", "f", "g", Vec3(0.0, 0.1, 0.0), "R2 ", {"qg"}));
   add_coordinate(m, "qa", 0.3);
-  add_coordinate(m, "qb1", -0.2);
+  add_coordinate(m, "qb1", -0.2, CoordinateSpec::Mode::kLocked);
   add_coordinate(m, "qb2", 0.4);
   add_coordinate(m, "qc1", 0.1);
-  add_coordinate(m, "qc2", 0.2);
+  add_coordinate(m, "qc2", 0.2, CoordinateSpec::Mode::kLocked);
   add_coordinate(m, "qc3", -0.3);
   add_coordinate(m, "qd", 0.5);
   add_coordinate(m, "qe1", 0.05);

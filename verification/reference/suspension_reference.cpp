@@ -52,7 +52,8 @@ RodVector rod_vector(const SuspensionData& data, const CarrierPose& pose, int k)
 }
 
 // Jacobian row of a scalar g(d) with gradient `gradient` = dg/dd, d = r + p - bp:
-//   delta d = delta p + delta theta x r  =>  delta g = gradient . delta p + (r x gradient) . delta theta.
+//   delta d = delta p + delta theta x r
+//   =>  delta g = gradient . delta p + (r x gradient) . delta theta.
 Eigen::Matrix<double, 1, 6> row_for_vector(const Vector3& gradient, const Vector3& lever) {
   Eigen::Matrix<double, 1, 6> row;
   row.head<3>() = gradient.transpose();
@@ -354,7 +355,8 @@ PoseSensitivity pose_sensitivity(const SuspensionData& data, const CarrierPose& 
   //            =>  u.(p'' + omega' x r) = -(|d'|^2 + d.(omega x (omega x r))) / |d|;
   //   atan2(d_z, d_y) = q4  =>  N = d_y d_z' - d_z d_y' = rho^2 (rho^2 = d_y^2 + d_z^2), and
   //            N' = d_y d_z'' - d_z d_y'' = (rho^2)' = 2 (d_y d_y' + d_z d_z')
-  //            =>  a.(p'' + omega' x r) = 2 (d_y d_y' + d_z d_z') / rho^2 - a.(omega x (omega x r)),
+  //            =>  a.(p'' + omega' x r) = 2 (d_y d_y' + d_z d_z') / rho^2
+  //                                       - a.(omega x (omega x r)),
   //               a = (0, -d_z, d_y) / rho^2.
   Vector6 gamma;
   for (int k = 1; k <= 5; ++k) {
@@ -381,7 +383,8 @@ PoseSensitivity pose_sensitivity(const SuspensionData& data, const CarrierPose& 
 
 PointMotion carrier_point_motion(const CarrierPose& pose, const PoseSensitivity& sensitivity,
                                  const Vector3& point_in_carrier) {
-  // x = p + R c (+ chassis offset); x' = p' + omega x r; x'' = p'' + omega' x r + omega x (omega x r).
+  // x = p + R c (+ chassis offset), r = R c:
+  //   x' = p' + omega x r,   x'' = p'' + omega' x r + omega x (omega x r).
   const Vector3 lever = pose.rotation * point_in_carrier;
   const Vector3& omega = sensitivity.omega;
   PointMotion motion;
@@ -625,25 +628,37 @@ VehicleEquilibrium solve_vehicle_equilibrium(const SuspensionData& data,
     // continuation and set the chassis height.
     pose = continue_pose(data, pose, pose_q4, solution.q4);
     pose_q4 = solution.q4;
+    // Globalization: without tyre contact G1 = -M g does not depend on q1 and the Jacobian is
+    // singular. G1 is linear in q1 in contact, so put the chassis where G1 = 0 exactly:
+    //   q1 = r cos(camber) - z~(q4) - M g / K_t,   z~ = wheel-centre height relative to chassis.
+    pose.chassis_z = 0.0;
+    const WheelOutputs relative = wheel_outputs(data, pose);
+    if (tyre_compression(data, relative, -solution.q1) <= 0.0) {  // ground at -q1 from chassis
+      solution.q1 = data.tyre_radius * std::cos(relative.camber) - relative.centre.z() -
+                    total_mass(data) * data.gravity / data.tyre_stiffness;
+    }
     pose.chassis_z = solution.q1;
     const VehicleEquations equations = vehicle_equations(data, spring_free_length, pose);
     local.vertical_residual = std::abs(equations.residual(0));
     local.q4_residual = std::abs(equations.residual(1));
     local.tyre_force = equations.tyre_force;
     local.pose = pose;
-    // Stop once a Newton step has changed nothing beyond rounding (quadratic convergence makes
-    // the step after that pure noise).
+    // Stop after a step below 1e-12: with quadratic convergence the error left after it is
+    // O(1e-24), i.e. the iterate is exact to rounding.
     if (last_step_negligible) {
       local.converged = true;
       break;
     }
     if (local.iterations >= max_iterations) break;
-    const Eigen::Vector2d step = equations.jacobian.fullPivLu().solve(-equations.residual);
+    Eigen::Vector2d step = equations.jacobian.fullPivLu().solve(-equations.residual);
     if (!step.allFinite()) break;
+    // Step limit (inactive near the solution): at most 0.2 rad of q4 per iteration.
+    const double max_q4_step = 0.2;
+    if (std::abs(step(1)) > max_q4_step) step *= max_q4_step / std::abs(step(1));
     solution.q1 += step(0);
     solution.q4 += step(1);
     ++local.iterations;
-    last_step_negligible = step.lpNorm<Eigen::Infinity>() < 1e-14;
+    last_step_negligible = step.lpNorm<Eigen::Infinity>() < 1e-12;
   }
   if (report != nullptr) {
     *report = local;

@@ -73,9 +73,11 @@ void print_equilibria(const ref::SuspensionData& data, const ref::CarrierPose& p
               spring.first);
   std::printf("  Z0 = %.15f m  (spring tension %.9f N)\n", z0,
               data.spring_stiffness * (spring.length - z0));
-  std::printf("  generalized forces along q4: gravity %.9f, tyre %.9f, spring %.9f, total %.3e N m\n",
+  std::printf("  generalized forces along q4: gravity %.9f, tyre %.9f, spring %.9f, "
+              "total %.3e N m\n",
               force.gravity, force.tyre, force.spring, force.total);
-  std::printf("  tyre camber work term K_t e r sin(phi) phi' = %.9f N m (not in the spec's force)\n",
+  std::printf("  tyre camber work term K_t e r sin(phi) phi' = %.9f N m "
+              "(not in the spec's force)\n",
               ref::tyre_camber_work_q4(data, pose));
 
   ref::VehicleEquilibriumReport report;
