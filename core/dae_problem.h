@@ -35,6 +35,8 @@ class DaeProblem {
   // After an event (roots_found non-null, IDA's +-1/0 per switch) or at a breakpoint (null):
   // update modes and make (y, y') consistent at t. Throws SolveError on failure.
   virtual void restart(double /*t*/, double* /*y*/, double* /*yp*/, const int* /*roots_found*/) {}
+  // Whether the roots found would change a mode (false: the event is ignored).
+  virtual bool changes_mode(double /*t*/, const double* /*y*/, const int* /*roots_found*/) { return true; }
   // Times where the problem's inputs are not smooth; the integrator stops and restarts there.
   virtual std::vector<double> breakpoints() const { return {}; }
   // Called after every accepted step with the step's solution.

@@ -208,9 +208,14 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     emit_until(t, true);
     if (flag == IDA_ROOT_RETURN || flag == IDA_TSTOP_RETURN) {
       if (t >= o.t1) break;
-      const bool is_root = flag == IDA_ROOT_RETURN;
+      // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
+      const bool at_breakpoint =
+          next_bp < bps.size() && std::fabs(t - bps[next_bp]) <= 1e-12 * std::max(1.0, std::fabs(t));
+      const bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
       if (is_root) {
         IDAGetRootInfo(mem, roots.data());
+        // A root that changes no mode (a switching function grazing zero) needs no restart.
+        if (!problem.changes_mode(t, N_VGetArrayPointer(y), roots.data())) continue;
         stats.event_times.push_back(t);
       } else {
         stats.breakpoint_times.push_back(t);

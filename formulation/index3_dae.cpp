@@ -115,6 +115,12 @@ void Index3Dae::consistent_initial_values(double t, std::vector<double>& y, std:
                          " (redundant constraints or an unconstrained massless body)");
 }
 
+bool Index3Dae::changes_mode(double, const double*, const int* roots) {
+  for (size_t k = 0; k < switch_forces_.size(); ++k)
+    if (roots[k] != 0 && modes[switch_forces_[k]] != (roots[k] > 0)) return true;
+  return false;
+}
+
 void Index3Dae::restart(double t, double* y, double* yp, const int* roots) {
   // New modes: flip the switches that crossed zero; at breakpoints, re-evaluate all from signs.
   for (size_t k = 0; k < switch_forces_.size(); ++k) {

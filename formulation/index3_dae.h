@@ -36,6 +36,7 @@ class Index3Dae : public DaeProblem {
   int num_switches() const override { return static_cast<int>(switch_forces_.size()); }
   void switches(double t, const double* y, double* g) override;
   void restart(double t, double* y, double* yp, const int* roots_found) override;
+  bool changes_mode(double t, const double* y, const int* roots_found) override;
   std::vector<double> breakpoints() const override { return sys_.breakpoints(); }
   void after_step(double t, const double* y) override;
 
