@@ -386,7 +386,8 @@ struct Loader {
     static const std::map<std::string, T> types = {
         {"position", T::kPosition}, {"velocity", T::kVelocity}, {"acceleration", T::kAcceleration},
         {"axis", T::kAxis}, {"coordinate", T::kCoordinate}, {"coordinate_rate", T::kCoordinateRate},
-        {"force_length", T::kForceLength}, {"force_value", T::kForceValue}, {"expression", T::kExpression}};
+        {"force_length", T::kForceLength}, {"force_value", T::kForceValue}, {"expression", T::kExpression},
+        {"kinetic_energy", T::kKineticEnergy}, {"potential_energy", T::kPotentialEnergy}};
     auto it = types.find(type);
     if (it == types.end()) {
       if (!type.empty()) error(n["type"], "type", "unknown sensor type '" + type + "'");

@@ -39,6 +39,9 @@ class DaeProblem {
   virtual bool changes_mode(double /*t*/, const double* /*y*/, const int* /*roots_found*/) { return true; }
   // Times where the problem's inputs are not smooth; the integrator stops and restarts there.
   virtual std::vector<double> breakpoints() const { return {}; }
+  // The integrator works on [t_start, t_end] up to the next breakpoint: inputs that jump at
+  // t_end must be evaluated with their left limit there.
+  virtual void set_segment(double /*t_start*/, double /*t_end*/) {}
   // Called after every accepted step with the step's solution.
   virtual void after_step(double /*t*/, const double* /*y*/) {}
 };

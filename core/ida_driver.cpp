@@ -33,8 +33,11 @@ struct UserData {
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
   auto* u = static_cast<UserData*>(ud);
+  // Before the first step after an (re)initialization the step to be tried is the initial one.
   double h = 0;
-  IDAGetCurrentStep(u->mem, &h);
+  long steps = 0;
+  IDAGetNumSteps(u->mem, &steps);
+  if (steps > 0) IDAGetCurrentStep(u->mem, &h);
   if (!(h > 0)) h = u->h_initial;
   // The weights are kept until the next successful step, also through step reductions after
   // a failure: evaluate them for a step ten times smaller than the one about to be tried.
@@ -184,6 +187,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   double t = o.t0;
   size_t next_bp = 0;
   IDASetStopTime(mem, next_bp < bps.size() ? bps[next_bp] : o.t1);
+  problem.set_segment(t, next_bp < bps.size() ? bps[next_bp] : o.t1);
   while (!stop_requested && t < o.t1) {
     double tret = t;
     const int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
@@ -222,6 +226,8 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
         ++next_bp;
       }
       collect(mem, stats);
+      while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
+      problem.set_segment(t, next_bp < bps.size() ? bps[next_bp] : o.t1);
       try {
         problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
       } catch (const SolveError& e) {
@@ -233,7 +239,6 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
       }
       ++stats.restarts;
       IDAReInit(mem, t, y, yp);
-      while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
       IDASetStopTime(mem, next_bp < bps.size() ? bps[next_bp] : o.t1);
       // A sample exactly at the restart time is re-emitted with the restarted state
       // (consistent accelerations after the switch) only if not yet emitted.

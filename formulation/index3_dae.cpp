@@ -27,7 +27,8 @@ Index3Dae::Index3Dae(const System& sys, double constraint_scale)
   asm_.finalize();
 }
 
-int Index3Dae::residual(double t, const double* y, const double* yp, double* r) {
+int Index3Dae::residual(double t_in, const double* y, const double* yp, double* r) {
+  const double t = input_time(t_in);
   const double* q = y;
   const double* v = y + nq_;
   const double* lambda = y + 2 * nq_;
@@ -62,7 +63,8 @@ void Index3Dae::assemble(double t, double cj, const double* y, const double* yp)
   assemble_constraint_jacobian(sys_, offsets_, q, scale_, rl, cq, rv, cl, asm_);
 }
 
-int Index3Dae::jacobian(double t, double cj, const double* y, const double* yp, double* values) {
+int Index3Dae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
+  const double t = input_time(t_in);
   asm_.begin_values(values);
   assemble(t, cj, y, yp);
   return 0;
@@ -91,7 +93,8 @@ std::string Index3Dae::component_name(int i) const {
   return "y[" + std::to_string(i) + "]";
 }
 
-void Index3Dae::switches(double t, const double* y, double* g) {
+void Index3Dae::switches(double t_in, const double* y, double* g) {
+  const double t = input_time(t_in);
   for (size_t k = 0; k < switch_forces_.size(); ++k) {
     const Force& f = sys_.forces[switch_forces_[k]];
     g[k] = force_switch_value(f, gather(y, f.bi, f.bj), t);
@@ -138,7 +141,8 @@ void Index3Dae::restart(double t, double* y, double* yp, const int* roots) {
   std::copy(yyp.begin(), yyp.end(), yp);
 }
 
-void Index3Dae::after_step(double t, const double* y) {
+void Index3Dae::after_step(double t_in, const double* y) {
+  const double t = input_time(t_in);
   constraint_values(sys_, offsets_, y, t, work_.data());
   max_position_violation = std::fmax(max_position_violation, max_abs(work_.data(), nc_));
   for (int b = 0; b < sys_.num_bodies(); ++b) {
@@ -147,8 +151,9 @@ void Index3Dae::after_step(double t, const double* y) {
   }
 }
 
-double Index3Dae::consistent_output(double t, const double* y, std::vector<double>& q,
+double Index3Dae::consistent_output(double t_in, const double* y, std::vector<double>& q,
                                     std::vector<double>& v, std::vector<double>& a) {
+  const double t = input_time(t_in);
   q.assign(y, y + nq_);
   v.assign(y + nq_, y + 2 * nq_);
   a.resize(nq_);

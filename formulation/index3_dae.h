@@ -10,6 +10,7 @@
 // the applied forces' derivatives and sum_k lambda_k d2Phi_k/dq2.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "core/dae_problem.h"
@@ -39,6 +40,13 @@ class Index3Dae : public DaeProblem {
   bool changes_mode(double t, const double* y, const int* roots_found) override;
   std::vector<double> breakpoints() const override { return sys_.breakpoints(); }
   void after_step(double t, const double* y) override;
+  void set_segment(double t_start, double t_end) override { segment_end_ = t_end; }
+  // Time at which inputs (drives, ground profiles, forces) are evaluated: t itself, except at
+  // the end of the current segment, where a jump must not be seen yet (left limit).
+  double input_time(double t) const {
+    const double cap = segment_end_ - 1e-13 * (1.0 + std::fabs(segment_end_));
+    return t < cap ? t : cap;
+  }
 
   // Consistent initial values at rest or from given q, v: solves accelerations and multipliers.
   void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
@@ -62,6 +70,7 @@ class Index3Dae : public DaeProblem {
   int nq_, nc_;
   double scale_;
   double mass_scale_ = 1e-3;
+  double segment_end_ = 1e300;
   std::vector<int> switch_forces_;
   SparseAssembler asm_;
   AugmentedSolver aug_;

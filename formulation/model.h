@@ -91,7 +91,8 @@ struct SensorSpec {
     kAxis,                                // world component of a body-fixed unit vector
     kCoordinate, kCoordinateRate,         // joint coordinate and its rate
     kForceLength, kForceValue,            // length / tension of a force element
-    kExpression                           // derived from other sensors
+    kExpression,                          // derived from other sensors
+    kKineticEnergy, kPotentialEnergy      // whole system (formulation/sensors.cpp)
   };
   std::string name;
   Type type = Type::kPosition;

@@ -1,0 +1,580 @@
+#include "cases/scene_validation.h"
+
+#include <algorithm>
+#include <set>
+
+#include "core/errors.h"
+#include "core/expression.h"
+#include "formulation/forces.h"
+
+namespace mbdae {
+
+std::string SceneIssue::text() const { return ModelError::format(file, line, field, message); }
+
+void FieldLines::add(const SourceLocation& item, const std::string& field, int line) {
+  if (line <= 0) return;
+  const auto key = std::make_tuple(item.file, item.line, field);
+  auto it = lines_.find(key);
+  if (it == lines_.end()) lines_.emplace(key, line);
+  else if (it->second != line) it->second = 0;  // two items start on one line: ambiguous
+}
+
+int FieldLines::line(const SourceLocation& item, const std::string& field) const {
+  auto it = lines_.find(std::make_tuple(item.file, item.line, field));
+  if (it != lines_.end() && it->second > 0) return it->second;
+  const size_t bracket = field.find('[');
+  if (bracket != std::string::npos) {
+    it = lines_.find(std::make_tuple(item.file, item.line, field.substr(0, bracket)));
+    if (it != lines_.end() && it->second > 0) return it->second;
+  }
+  return item.line;
+}
+
+namespace {
+
+// The evaluation stack of Expression::evaluate (core/expression.cpp) holds 64 values.
+constexpr int kExpressionStack = 64;
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// "; did you mean 'x'?" for the closest candidate within a small edit distance.
+template <class Names>
+std::string suggestion(const std::string& name, const Names& candidates) {
+  if (name.size() > 64) return "";
+  std::string best;
+  size_t best_d = std::max<size_t>(1, std::min<size_t>(2, name.size() / 3));
+  for (const auto& c : candidates) {
+    if (c.size() > 64) continue;
+    const size_t d = edit_distance(name, c);
+    if (d <= best_d && (best.empty() || d < best_d)) {
+      best = c;
+      best_d = d;
+    }
+  }
+  return best.empty() ? "" : "; did you mean '" + best + "'?";
+}
+
+}  // namespace
+
+std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates) {
+  return suggestion(name, candidates);
+}
+
+namespace {
+
+std::string chain_text(const std::vector<ElementaryJoint>& chain) {
+  std::string s;
+  for (const auto& e : chain) {
+    if (!s.empty()) s += ' ';
+    s += (e.rotation ? 'R' : 'T');
+    s += static_cast<char>('1' + e.axis);
+  }
+  return s.empty() ? "weld" : s;
+}
+
+std::string indexed(const std::string& field, size_t k) { return field + "[" + std::to_string(k) + "]"; }
+
+struct Validator {
+  const Scene& scene;
+  const Model& m;
+  const FieldLines& lines;
+  std::vector<SceneIssue>& issues;
+
+  std::map<std::string, const BodySpec*> bodies;
+  std::map<std::string, const JointSpec*> joint_of_child;       // the tree joint of each body
+  std::map<std::string, const JointSpec*> joint_of_coordinate;  // coordinates used by joints
+  std::set<std::string> placed = {kGround};                     // bodies with a path to ground
+  std::map<std::string, std::string> host = {{kGround, kGround}};  // rigid body each is merged into
+  std::set<std::string> merged_coordinates;                        // coordinates of merged joints
+  std::map<std::string, const ForceSpec*> forces;
+  std::map<std::string, size_t> sensor_index;  // first sensor of each name
+
+  // `field` locates the line (it may carry an index); the message shows it without the index,
+  // or `shown` if given.
+  void report(const SourceLocation& item, const std::string& field, const std::string& message,
+              const std::string& shown = "") {
+    std::string f = shown.empty() ? field : shown;
+    const size_t bracket = f.find('[');
+    if (bracket != std::string::npos) f.erase(bracket);
+    issues.push_back({item.file, lines.line(item, field), f, message});
+  }
+  std::string at(const SourceLocation& first, const SourceLocation& here) const {
+    if (first.file == here.file) return "line " + std::to_string(first.line);
+    return first.file + ":" + std::to_string(first.line);
+  }
+  bool known_body(const std::string& b) const { return b == kGround || bodies.count(b); }
+  std::vector<std::string> body_names() const {
+    std::vector<std::string> v = {kGround};
+    for (const auto& [n, b] : bodies) v.push_back(n);
+    return v;
+  }
+  template <class Map>
+  static std::vector<std::string> keys(const Map& map) {
+    std::vector<std::string> v;
+    for (const auto& kv : map) v.push_back(kv.first);
+    return v;
+  }
+  std::string no_body(const std::string& name) const {
+    return "no body named '" + name + "'" + suggestion(name, body_names());
+  }
+
+  // A body and one of its points: "" or "origin" (the body frame's origin), "com", or a named
+  // point. Ground has only its origin.
+  void check_point(const SourceLocation& w, const std::string& who, const std::string& body_field,
+                   const std::string& body, const std::string& point_field, const std::string& point) {
+    if (body.empty()) return;  // reported as missing by the loader
+    if (!known_body(body)) {
+      report(w, body_field, who + no_body(body));
+      return;
+    }
+    if (point.empty() || point == "origin") return;
+    if (body == kGround) {
+      report(w, point_field, who + "ground has no named points (only 'origin')");
+      return;
+    }
+    if (point == "com") return;
+    const BodySpec& b = *bodies.at(body);
+    if (b.points.count(point)) return;
+    std::vector<std::string> names = {"origin", "com"};
+    for (const auto& kv : b.points) names.push_back(kv.first);
+    std::string list;
+    for (size_t k = 0; k < names.size() && k < 12; ++k) list += (k ? ", " : "") + names[k];
+    if (names.size() > 12) list += ", ...";
+    report(w, point_field, who + "body '" + body + "' has no point '" + point + "' (its points: " + list + ")" +
+                               suggestion(point, names));
+  }
+
+  void check_bodies() {
+    for (const auto& b : m.bodies) {
+      if (b.name.empty()) continue;
+      if (b.name == kGround) {
+        report(b.where, "name", "'ground' is reserved for the fixed frame; name the body differently");
+        continue;
+      }
+      auto [it, fresh] = bodies.emplace(b.name, &b);
+      if (!fresh)
+        report(b.where, "name", "body '" + b.name + "' is defined twice (first at " + at(it->second->where, b.where) + ")");
+    }
+  }
+
+  void check_chain(const JointSpec& j, const std::string& who) {
+    int switches = 0;
+    std::vector<int> rot, trans;
+    for (size_t k = 0; k < j.chain.size(); ++k) {
+      if (k > 0 && j.chain[k].rotation != j.chain[k - 1].rotation) ++switches;
+      (j.chain[k].rotation ? rot : trans).push_back(j.chain[k].axis);
+    }
+    if (switches > 1)
+      report(j.where, "chain", who + "chain " + chain_text(j.chain) +
+                                   " interleaves rotations and translations; split it with an intermediate body");
+    for (const auto* axes : {&rot, &trans}) {
+      const std::set<int> s(axes->begin(), axes->end());
+      if (s.size() != axes->size())
+        report(j.where, "chain", who + "chain " + chain_text(j.chain) + " repeats a " +
+                                     (axes == &rot ? "rotation" : "translation") +
+                                     " axis (proper Euler sequences are not supported)");
+    }
+  }
+
+  void check_joints() {
+    std::map<std::string, const JointSpec*> names;
+    for (const auto& j : m.joints) {
+      const std::string who = "joint '" + j.name + "': ";
+      if (!j.name.empty()) {
+        auto [it, fresh] = names.emplace(j.name, &j);
+        if (!fresh)
+          report(j.where, "name", "joint '" + j.name + "' is defined twice (first at " + at(it->second->where, j.where) + ")");
+      }
+      if (!j.parent.empty() && !known_body(j.parent)) report(j.where, "parent", who + no_body(j.parent));
+      if (!j.child.empty()) {
+        if (j.child == kGround) {
+          report(j.where, "child", who + "ground cannot be the child of a joint (it is the fixed frame)");
+        } else if (!bodies.count(j.child)) {
+          report(j.where, "child", who + no_body(j.child));
+        } else {
+          // A joint from a body to itself is kept in the tree as a loop of one body.
+          if (j.child == j.parent) report(j.where, "parent", who + "joins body '" + j.child + "' to itself");
+          auto [it, fresh] = joint_of_child.emplace(j.child, &j);
+          if (!fresh)
+            report(j.where, "child", who + "body '" + j.child + "' is already the child of joint '" +
+                                         it->second->name + "' (at " + at(it->second->where, j.where) +
+                                         "); a body has one tree joint, make the other a cut");
+        }
+      }
+      check_chain(j, who);
+      for (size_t k = 0; k < j.chain.size(); ++k) {
+        const std::string& c = j.chain[k].coordinate;
+        if (c.empty()) continue;  // the loader reported the count mismatch
+        const std::string field = indexed("coordinates", k);
+        if (!m.coordinates.count(c))
+          report(j.where, field, who + "coordinate '" + c + "' has no entry under 'coordinates' (give at least its initial value)" +
+                                     suggestion(c, keys(m.coordinates)));
+        auto [it, fresh] = joint_of_coordinate.emplace(c, &j);
+        if (!fresh)
+          report(j.where, field, who + "coordinate '" + c + "' is " +
+                                     (it->second == &j ? "used twice in this joint"
+                                                       : "already used by joint '" + it->second->name + "' (at " +
+                                                             at(it->second->where, j.where) + ")"));
+      }
+      if (!j.anchor_point.empty() && !j.parent.empty()) {
+        if (j.parent == kGround) {
+          report(j.where, "anchor", who + "ground has no named points; give the anchor as [x, y, z]");
+        } else if (bodies.count(j.parent) && j.parent != j.child) {
+          const BodySpec& p = *bodies.at(j.parent);
+          if (!p.points.count(j.anchor_point)) {
+            std::string list;
+            for (const auto& kv : p.points) list += (list.empty() ? "" : ", ") + kv.first;
+            report(j.where, "anchor", who + "body '" + j.parent + "' has no point '" + j.anchor_point + "'" +
+                                          (list.empty() ? " (it has no named points)" : " (its points: " + list + ")") +
+                                          suggestion(j.anchor_point, keys(p.points)));
+          }
+        }
+      }
+    }
+    for (const auto& [name, c] : m.coordinates)
+      if (!joint_of_coordinate.count(name))
+        report(c.where, "name", "coordinate '" + name + "' belongs to no joint" +
+                                    suggestion(name, keys(joint_of_coordinate)),
+               "coordinates." + name);
+  }
+
+  // Orders the tree from ground outwards, reports loops and bodies without a path to ground,
+  // and finds which bodies are merged together by locked or welded joints.
+  void check_tree() {
+    std::vector<const JointSpec*> order;
+    for (bool progress = true; progress;) {
+      progress = false;
+      for (const auto& [child, j] : joint_of_child)
+        if (!placed.count(child) && placed.count(j->parent)) {
+          order.push_back(j);
+          placed.insert(child);
+          progress = true;
+        }
+    }
+    for (const JointSpec* j : order) {
+      bool merge = true;
+      for (const auto& e : j->chain) {
+        auto it = m.coordinates.find(e.coordinate);
+        if (it == m.coordinates.end() || it->second.mode != CoordinateSpec::Mode::kLocked) merge = false;
+      }
+      host[j->child] = merge ? host[j->parent] : j->child;
+      if (merge)
+        for (const auto& e : j->chain) merged_coordinates.insert(e.coordinate);
+    }
+    // Each body without a path to ground is cut off by a root cause: an ancestor without a
+    // joint, a loop, or a joint to an unknown parent (reported already).
+    struct Cause {
+      std::vector<std::string> loop;  // empty: `root` has no joint
+      std::string root;
+      std::vector<std::string> cut_off;
+    };
+    std::map<std::string, Cause> causes;
+    std::vector<std::string> cause_order;
+    for (const auto& b : m.bodies) {
+      if (placed.count(b.name) || !bodies.count(b.name) || bodies.at(b.name) != &b) continue;
+      std::vector<std::string> path;
+      std::string cur = b.name, key;
+      Cause cause;
+      for (;;) {
+        auto seen = std::find(path.begin(), path.end(), cur);
+        if (seen != path.end()) {  // a loop: the path from `cur` on
+          cause.loop.assign(seen, path.end());
+          key = "loop:" + *std::min_element(cause.loop.begin(), cause.loop.end());
+          break;
+        }
+        path.push_back(cur);
+        auto it = joint_of_child.find(cur);
+        if (it == joint_of_child.end()) {
+          cause.root = cur;
+          key = "root:" + cur;
+          break;
+        }
+        const std::string& parent = it->second->parent;
+        if (parent.empty() || !known_body(parent) || placed.count(parent)) break;  // reported elsewhere
+        cur = parent;
+      }
+      if (key.empty()) continue;
+      auto [it, fresh] = causes.emplace(key, cause);
+      if (fresh) cause_order.push_back(key);
+      const bool in_cause = it->second.root == b.name ||
+                            std::find(it->second.loop.begin(), it->second.loop.end(), b.name) != it->second.loop.end();
+      if (!in_cause) it->second.cut_off.push_back(b.name);
+    }
+    for (const auto& key : cause_order) {
+      const Cause& c = causes.at(key);
+      std::string also;
+      for (const auto& n : c.cut_off) also += (also.empty() ? "" : ", ") + ("'" + n + "'");
+      if (!also.empty()) also = "; nor do the bodies attached to it: " + also;
+      if (c.loop.empty()) {
+        report(bodies.at(c.root)->where, "name",
+               "body '" + c.root + "' has no joint to a parent (no path to ground)" + also);
+        continue;
+      }
+      if (c.loop.size() == 1) continue;  // a joint from a body to itself, reported already
+      // Report at the loop's joint that comes first in the file.
+      const JointSpec* first = nullptr;
+      std::string path, joints;
+      for (const auto& n : c.loop) {
+        const JointSpec* j = joint_of_child.at(n);
+        if (!first || j < first) first = j;
+        path += "'" + n + "' -> ";
+        joints += (joints.empty() ? "'" : ", '") + j->name + "'";
+      }
+      path += "'" + c.loop.front() + "'";
+      report(first->where, "parent",
+             "the joint tree has a loop: " + path + " (child -> parent), so these bodies have no path to ground" +
+                 also + "; make one of the joints " + joints + " a cut");
+    }
+  }
+
+  bool same_rigid_body(const std::string& a, const std::string& b) const {
+    auto ha = host.find(a), hb = host.find(b);
+    return ha != host.end() && hb != host.end() && ha->second == hb->second;
+  }
+
+  void check_cuts() {
+    std::map<std::string, const CutSpec*> names;
+    for (const auto& c : m.cuts) {
+      const std::string who = "cut '" + c.name + "': ";
+      if (!c.name.empty()) {
+        auto [it, fresh] = names.emplace(c.name, &c);
+        if (!fresh)
+          report(c.where, "name", "cut '" + c.name + "' is defined twice (first at " + at(it->second->where, c.where) + ")");
+      }
+      check_point(c.where, who, "body1", c.body1, "point1", c.point1);
+      check_point(c.where, who, "body2", c.body2, "point2", c.point2);
+      if (c.body1.empty() || c.body2.empty()) continue;
+      if (c.body1 == c.body2)
+        report(c.where, "body2", who + "joins body '" + c.body1 + "' to itself");
+      else if (same_rigid_body(c.body1, c.body2))
+        report(c.where, "body2", who + "joins two parts of the same rigid body ('" + c.body1 + "' and '" + c.body2 +
+                                       "' are welded or locked together)");
+    }
+  }
+
+  void check_forces() {
+    for (const auto& f : m.forces) {
+      const std::string who = "force '" + f.name + "': ";
+      if (!f.name.empty()) {
+        auto [it, fresh] = forces.emplace(f.name, &f);
+        if (!fresh)
+          report(f.where, "name", "force '" + f.name + "' is defined twice (first at " + at(it->second->where, f.where) + ")");
+      }
+      switch (f.type) {
+        case ForceSpec::Type::kSpringDamper:
+        case ForceSpec::Type::kUser:
+          check_point(f.where, who, "body1", f.body1, "point1", f.point1);
+          check_point(f.where, who, "body2", f.body2, "point2", f.point2);
+          break;
+        case ForceSpec::Type::kPointForce:
+        case ForceSpec::Type::kWheelContact:
+          check_point(f.where, who, "body", f.body1, "point", f.point1);
+          break;
+      }
+      if (f.type == ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&
+          same_rigid_body(f.body1, kGround))
+        report(f.where, "body", who + "wheel contact on '" + f.body1 + "', which is fixed to ground " +
+                                    (f.body1 == kGround ? "" : "(its joints to ground are locked or welds)"));
+      if (f.type == ForceSpec::Type::kUser && !f.law.empty()) {
+        const UserForceLaw* law = find_force_law(f.law);
+        if (!law) {
+          report(f.where, "law", who + "no force law named '" + f.law + "' is registered");
+          continue;
+        }
+        std::string list;
+        for (const auto& p : law->parameter_names) list += (list.empty() ? "" : ", ") + p;
+        for (const auto& p : law->parameter_names)
+          if (!f.parameters.count(p)) report(f.where, "parameters", who + "force law '" + f.law + "' needs parameter '" + p + "'");
+        for (const auto& [p, v] : f.parameters)
+          if (std::find(law->parameter_names.begin(), law->parameter_names.end(), p) == law->parameter_names.end())
+            report(f.where, "parameters." + p, who + "force law '" + f.law + "' has no parameter '" + p + "' (" +
+                                                   (list.empty() ? "it has none" : "its parameters: " + list) + ")" +
+                                                   suggestion(p, law->parameter_names));
+      }
+    }
+  }
+
+  void check_sensors() {
+    for (size_t k = 0; k < m.sensors.size(); ++k) {
+      const SensorSpec& s = m.sensors[k];
+      if (s.name.empty()) continue;
+      auto [it, fresh] = sensor_index.emplace(s.name, k);
+      if (!fresh)
+        report(s.where, "name", "sensor '" + s.name + "' is defined twice (first at " +
+                                    at(m.sensors[it->second].where, s.where) + ")");
+    }
+    std::map<std::string, int> before;  // sensors listed before the current one
+    for (size_t k = 0; k < m.sensors.size(); ++k) {
+      const SensorSpec& s = m.sensors[k];
+      const std::string who = "sensor '" + s.name + "': ";
+      using T = SensorSpec::Type;
+      switch (s.type) {
+        case T::kPosition:
+        case T::kVelocity:
+        case T::kAcceleration:
+          check_point(s.where, who, "body", s.body, "point", s.point);
+          break;
+        case T::kAxis:
+          if (!s.body.empty() && !known_body(s.body)) report(s.where, "body", who + no_body(s.body));
+          break;
+        case T::kCoordinate:
+        case T::kCoordinateRate:
+          if (!s.target.empty() && !joint_of_coordinate.count(s.target))
+            report(s.where, "coordinate", who + "no joint coordinate named '" + s.target + "'" +
+                                              suggestion(s.target, keys(joint_of_coordinate)));
+          break;
+        case T::kForceLength:
+        case T::kForceValue:
+          if (!s.target.empty() && !forces.count(s.target))
+            report(s.where, "force", who + "no force named '" + s.target + "'" + suggestion(s.target, keys(forces)));
+          break;
+        case T::kExpression:
+          check_expression(s, who, before);
+          break;
+        default:
+          break;
+      }
+      before.emplace(s.name, static_cast<int>(k));
+    }
+  }
+
+  void check_expression(const SensorSpec& s, const std::string& who, const std::map<std::string, int>& before) {
+    if (s.expression.empty()) return;
+    std::vector<std::string> unknown;
+    try {
+      const Expression e = Expression::compile(s.expression, [&](const std::string& n) {
+        auto it = before.find(n);
+        if (it != before.end()) return it->second;
+        if (std::find(unknown.begin(), unknown.end(), n) == unknown.end()) unknown.push_back(n);
+        return 0;  // carry on to find every unknown name
+      });
+      int depth = 0, deepest = 0;
+      for (const auto& in : e.code) {
+        switch (in.op) {
+          case Expression::Op::kConst:
+          case Expression::Op::kVar: ++depth; break;
+          case Expression::Op::kNeg:
+          case Expression::Op::kCall1: break;
+          default: --depth; break;
+        }
+        deepest = std::max(deepest, depth);
+      }
+      if (deepest > kExpressionStack)
+        report(s.where, "expression", who + "the expression is nested too deeply (it needs " + std::to_string(deepest) +
+                                          " evaluation stack entries, at most " + std::to_string(kExpressionStack) + ")");
+    } catch (const ExpressionError& e) {
+      report(s.where, "expression", who + e.what());
+    }
+    for (const auto& n : unknown) {
+      auto later = sensor_index.find(n);
+      if (later != sensor_index.end())
+        report(s.where, "expression", who + "sensor '" + n + "' is listed after this one (an expression may use only sensors listed before it)");
+      else
+        report(s.where, "expression", who + "unknown name '" + n + "' (names are sensors listed before this one, and pi)" +
+                                          suggestion(n, keys(before)));
+    }
+  }
+
+  void check_output() {
+    std::set<std::string> seen;
+    for (size_t k = 0; k < scene.columns.size(); ++k) {
+      const std::string& c = scene.columns[k];
+      if (!sensor_index.count(c))
+        report(lines.scene_root, indexed("output", k), "no sensor named '" + c + "'" + suggestion(c, keys(sensor_index)));
+      else if (!seen.insert(c).second)
+        report(lines.scene_root, indexed("output", k), "sensor '" + c + "' is listed twice");
+    }
+  }
+
+  void check_coordinate_list(const AnalysisStep& s, const std::string& field, const std::vector<std::string>& names) {
+    std::set<std::string> seen;
+    for (size_t k = 0; k < names.size(); ++k) {
+      const std::string& n = names[k];
+      const std::string f = indexed(field, k);
+      if (!joint_of_coordinate.count(n))
+        report(s.where, f, "no joint coordinate named '" + n + "'" + suggestion(n, keys(joint_of_coordinate)));
+      else if (merged_coordinates.count(n))
+        report(s.where, f, "coordinate '" + n + "' is locked (its joint is merged); it cannot be held or solved for");
+      if (!seen.insert(n).second) report(s.where, f, "coordinate '" + n + "' is listed twice");
+    }
+  }
+
+  void check_steps() {
+    for (const auto& s : scene.steps) {
+      using A = AnalysisStep::Type;
+      if (s.type == A::kAssembly || s.type == A::kEquilibrium) check_coordinate_list(s, "hold", s.hold);
+      if (s.type == A::kEquilibrium) {
+        check_coordinate_list(s, "release", s.release);
+        for (size_t k = 0; k < s.release.size(); ++k)
+          if (std::find(s.hold.begin(), s.hold.end(), s.release[k]) == s.hold.end())
+            report(s.where, indexed("release", k), "coordinate '" + s.release[k] +
+                                                       "' is released but not held (release names held coordinates whose reaction must vanish)");
+        std::set<std::string> seen;
+        for (size_t k = 0; k < s.unknowns.size(); ++k) {
+          const std::string& u = s.unknowns[k];
+          const std::string f = indexed("unknowns", k);
+          if (!seen.insert(u).second) report(s.where, f, "'" + u + "' is listed twice");
+          const size_t dot = u.rfind('.');
+          if (dot == std::string::npos) {
+            report(s.where, f, "expected force.parameter (e.g. spring.free_length), got '" + u + "'");
+            continue;
+          }
+          const std::string fname = u.substr(0, dot), p = u.substr(dot + 1);
+          auto it = forces.find(fname);
+          if (it == forces.end()) {
+            report(s.where, f, "no force named '" + fname + "'" + suggestion(fname, keys(forces)));
+            continue;
+          }
+          std::vector<std::string> params;
+          if (it->second->type == ForceSpec::Type::kSpringDamper) params = {"free_length", "stiffness", "damping"};
+          if (it->second->type == ForceSpec::Type::kWheelContact) params = {"stiffness", "radius"};
+          if (std::find(params.begin(), params.end(), p) == params.end()) {
+            std::string list;
+            for (const auto& x : params) list += (list.empty() ? "" : ", ") + x;
+            report(s.where, f, "'" + p + "' is not a parameter of force '" + fname + "' (" +
+                                   (list.empty() ? "it has none that can be solved for" : "parameters: " + list) + ")" +
+                                   suggestion(p, params));
+          }
+        }
+        if (s.release.size() != s.unknowns.size())
+          report(s.where, s.release.empty() ? "unknowns" : "release",
+                 "one released coordinate is needed per unknown parameter (" + std::to_string(s.release.size()) +
+                     " released, " + std::to_string(s.unknowns.size()) + " unknown)");
+      }
+      if (s.type == A::kKinematics || s.type == A::kDynamics)
+        for (size_t k = 0; k < s.quiet_sensors.size(); ++k)
+          if (!sensor_index.count(s.quiet_sensors[k]))
+            report(s.where, indexed("quiet_sensors", k), "no sensor named '" + s.quiet_sensors[k] + "'" +
+                                                             suggestion(s.quiet_sensors[k], keys(sensor_index)));
+    }
+  }
+};
+
+}  // namespace
+
+void validate_scene(const Scene& scene, const FieldLines& lines, std::vector<SceneIssue>& issues) {
+  Validator v{scene, scene.model, lines, issues};
+  v.check_bodies();
+  v.check_joints();
+  v.check_tree();
+  v.check_cuts();
+  v.check_forces();
+  v.check_sensors();
+  v.check_output();
+  v.check_steps();
+}
+
+}  // namespace mbdae
