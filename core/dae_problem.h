@@ -35,6 +35,11 @@ class DaeProblem {
   // After an event (roots_found non-null, IDA's +-1/0 per switch) or at a breakpoint (null):
   // update modes and make (y, y') consistent at t. Throws SolveError on failure.
   virtual void restart(double /*t*/, double* /*y*/, double* /*yp*/, const int* /*roots_found*/) {}
+  // A first step for a (re)start at (t, y, y'), or 0 for the integrator's default.
+  virtual double initial_step(double /*t*/, const double* /*y*/, const double* /*yp*/,
+                              double /*rtol*/, double /*atol*/) {
+    return 0.0;
+  }
   // Whether the roots found would change a mode (false: the event is ignored).
   virtual bool changes_mode(double /*t*/, const double* /*y*/, const int* /*roots_found*/) { return true; }
   // Times where the problem's inputs are not smooth; the integrator stops and restarts there.

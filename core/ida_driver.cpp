@@ -84,14 +84,15 @@ void collect(void* mem, IdaStats& s) {
 }
 
 // Names of the components with the largest weighted local error estimates.
-std::string worst_components(void* mem, DaeProblem& p, N_Vector tmp1, N_Vector tmp2) {
+std::string worst_components(void* mem, DaeProblem& p, N_Vector tmp1, N_Vector tmp2, N_Vector id) {
   if (IDAGetErrWeights(mem, tmp1) != IDA_SUCCESS || IDAGetEstLocalErrors(mem, tmp2) != IDA_SUCCESS)
     return "";
   const double* w = N_VGetArrayPointer(tmp1);
   const double* e = N_VGetArrayPointer(tmp2);
   std::vector<int> idx(p.size());
   std::iota(idx.begin(), idx.end(), 0);
-  auto score = [&](int i) { return std::fabs(w[i] * e[i]); };
+  const double* mask = N_VGetArrayPointer(id);
+  auto score = [&](int i) { return mask[i] > 0 ? std::fabs(w[i] * e[i]) : 0.0; };
   const int k = std::min<int>(3, idx.size());
   std::partial_sort(idx.begin(), idx.begin() + k, idx.end(),
                     [&](int a, int b) { return score(a) > score(b); });
@@ -127,6 +128,13 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   void* mem = IDACreate(ctx);
   UserData ud{&problem, &pattern, mem, o.rtol, o.atol,
               o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0)};
+  const double h_cap = ud.h_initial;
+  auto choose_initial_step = [&](double tt) {
+    if (o.initial_step > 0) return;
+    const double h = problem.initial_step(tt, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), o.rtol, o.atol);
+    ud.h_initial = h > 0 ? std::min(h_cap, h) : h_cap;
+  };
+  choose_initial_step(o.t0);
   IDAInit(mem, residual_fn, o.t0, y, yp);
   IDAWFtolerances(mem, weights_fn);
   IDASetUserData(mem, &ud);
@@ -186,63 +194,108 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
 
   double t = o.t0;
   size_t next_bp = 0;
-  IDASetStopTime(mem, next_bp < bps.size() ? bps[next_bp] : o.t1);
-  problem.set_segment(t, next_bp < bps.size() ? bps[next_bp] : o.t1);
+  auto next_stop = [&] { return next_bp < bps.size() ? bps[next_bp] : o.t1; };
+  IDASetStopTime(mem, next_stop());
+  problem.set_segment(t, next_stop());
+  // The last accepted step (interpolated root states are never kept here).
+  double t_prev = t;
+  std::vector<double> y_prev(y0), yp_prev(yp0);
+  auto keep_step = [&](double tt) {
+    t_prev = tt;
+    std::memcpy(y_prev.data(), N_VGetArrayPointer(y), n * sizeof(double));
+    std::memcpy(yp_prev.data(), N_VGetArrayPointer(yp), n * sizeof(double));
+  };
+  auto failure = [&](int flag, double tt) {
+    collect(mem, stats);
+    std::ostringstream os;
+    double h = 0;
+    IDAGetCurrentStep(mem, &h);
+    IDAGetCurrentTime(mem, &tt);
+    os << "IDA failed at t = " << tt << " with step size " << h << " (" << IDAGetReturnFlagName(flag) << ")";
+    const std::string worst = worst_components(mem, problem, ys, yps, id);
+    if (!worst.empty()) os << "; largest error estimates: " << worst;
+    stats.ok = false;
+    stats.status = "integration_failed";
+    stats.message = os.str();
+    stats.t_reached = t;
+  };
   while (!stop_requested && t < o.t1) {
     double tret = t;
-    const int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
+    int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
     if (flag < 0) {
+      failure(flag, tret);
+      break;
+    }
+    // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
+    const bool at_breakpoint = next_bp < bps.size() &&
+                               std::fabs(tret - bps[next_bp]) <= 1e-12 * std::max(1.0, std::fabs(tret));
+    bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
+    if (is_root) {
+      IDAGetRootInfo(mem, roots.data());
+      // A root that changes no mode (a switching function grazing zero) needs no restart.
+      if (!problem.changes_mode(tret, N_VGetArrayPointer(y), roots.data())) continue;
+      // The state IDA returns at a root is interpolated, and the interpolated velocities are
+      // not error-controlled at index 3. Step back to the last accepted step and integrate again
+      // with the root time as stop time, so that the state at the root is a converged step.
+      const double t_root = tret;
       collect(mem, stats);
-      std::ostringstream os;
-      double h = 0;
-      IDAGetCurrentStep(mem, &h);
-      IDAGetCurrentTime(mem, &tret);
-      os << "IDA failed at t = " << tret << " with step size " << h << " (" << IDAGetReturnFlagName(flag)
-         << ")";
-      const std::string worst = worst_components(mem, problem, ys, yps);
-      if (!worst.empty()) os << "; largest error estimates: " << worst;
+      const double h_default = ud.h_initial;
+      choose_initial_step(t_prev);
+      ud.h_initial = std::min(ud.h_initial, t_root - t_prev);
+      if (ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
+        std::memcpy(N_VGetArrayPointer(y), y_prev.data(), n * sizeof(double));
+        std::memcpy(N_VGetArrayPointer(yp), yp_prev.data(), n * sizeof(double));
+        IDASetInitStep(mem, ud.h_initial);
+        IDAReInit(mem, t_prev, y, yp);
+        IDARootInit(mem, 0, nullptr);
+        IDASetStopTime(mem, t_root);
+        t = t_prev;
+      } else {
+        t = t_root;  // the root is at the last step: its state is that step's
+      }
+      while (t < t_root && !stop_requested) {
+        flag = IDASolve(mem, t_root, &tret, y, yp, IDA_ONE_STEP);
+        if (flag < 0) break;
+        t = tret;
+        problem.after_step(t, N_VGetArrayPointer(y));
+        emit_until(t, true);
+      }
+      IDARootInit(mem, nsw, root_fn);
+      ud.h_initial = h_default;
+      IDASetInitStep(mem, ud.h_initial);
+      if (flag < 0) {
+        failure(flag, tret);
+        break;
+      }
+      stats.event_times.push_back(t);
+    } else {
+      t = tret;
+      problem.after_step(t, N_VGetArrayPointer(y));
+      emit_until(t, true);
+      keep_step(t);
+      if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) continue;
+      if (t >= o.t1) break;
+      stats.breakpoint_times.push_back(t);
+      ++next_bp;
+    }
+    collect(mem, stats);
+    while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
+    problem.set_segment(t, next_stop());
+    try {
+      problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
+    } catch (const SolveError& e) {
       stats.ok = false;
-      stats.status = "integration_failed";
-      stats.message = os.str();
+      stats.status = e.status;
+      stats.message = std::string("restart at t = ") + std::to_string(t) + " failed: " + e.what();
       stats.t_reached = t;
       break;
     }
-    t = tret;
-    problem.after_step(t, N_VGetArrayPointer(y));
-    emit_until(t, true);
-    if (flag == IDA_ROOT_RETURN || flag == IDA_TSTOP_RETURN) {
-      if (t >= o.t1) break;
-      // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
-      const bool at_breakpoint =
-          next_bp < bps.size() && std::fabs(t - bps[next_bp]) <= 1e-12 * std::max(1.0, std::fabs(t));
-      const bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
-      if (is_root) {
-        IDAGetRootInfo(mem, roots.data());
-        // A root that changes no mode (a switching function grazing zero) needs no restart.
-        if (!problem.changes_mode(t, N_VGetArrayPointer(y), roots.data())) continue;
-        stats.event_times.push_back(t);
-      } else {
-        stats.breakpoint_times.push_back(t);
-        ++next_bp;
-      }
-      collect(mem, stats);
-      while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
-      problem.set_segment(t, next_bp < bps.size() ? bps[next_bp] : o.t1);
-      try {
-        problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
-      } catch (const SolveError& e) {
-        stats.ok = false;
-        stats.status = e.status;
-        stats.message = std::string("restart at t = ") + std::to_string(t) + " failed: " + e.what();
-        stats.t_reached = t;
-        break;
-      }
-      ++stats.restarts;
-      IDAReInit(mem, t, y, yp);
-      IDASetStopTime(mem, next_bp < bps.size() ? bps[next_bp] : o.t1);
-      // A sample exactly at the restart time is re-emitted with the restarted state
-      // (consistent accelerations after the switch) only if not yet emitted.
-    }
+    ++stats.restarts;
+    choose_initial_step(t);
+    IDASetInitStep(mem, ud.h_initial);
+    IDAReInit(mem, t, y, yp);
+    IDASetStopTime(mem, next_stop());
+    keep_step(t);
   }
   if (stats.ok) {
     collect(mem, stats);

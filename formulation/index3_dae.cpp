@@ -75,7 +75,13 @@ void Index3Dae::error_test_mask(double* id) const {
 }
 
 void Index3Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
-  const double av = atol / h, al = mass_scale_ * atol / (h * h);
+  // Rounding in the positions (about 1e3 eps |q|, through the constraints) reaches the Newton
+  // corrections of v and lambda amplified by 1/h and 1/h^2: that noise floor, not the user's
+  // atol, bounds how tightly they can converge.
+  double qmax = 1.0;
+  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
+  const double noise = 1e3 * 2.22e-16 * qmax;
+  const double av = atol + noise / h, al = mass_scale_ * (atol + noise / (h * h));
   for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
@@ -116,6 +122,17 @@ void Index3Dae::consistent_initial_values(double t, std::vector<double>& y, std:
     throw SolveError("singular",
                      "the augmented mass matrix is singular at t = " + std::to_string(t) +
                          " (redundant constraints or an unconstrained massless body)");
+}
+
+double Index3Dae::initial_step(double, const double* y, const double* yp, double rtol, double atol) {
+  // Weighted RMS norm of q'' = v' over the error-tested positions.
+  double sum = 0;
+  for (int i = 0; i < nq_; ++i) {
+    const double w = 1.0 / (rtol * std::fabs(y[i]) + atol);
+    sum += (yp[nq_ + i] * w) * (yp[nq_ + i] * w);
+  }
+  const double norm = std::sqrt(sum / nq_);
+  return norm > 0 ? 0.5 * std::sqrt(2.0 / norm) : 0.0;
 }
 
 bool Index3Dae::changes_mode(double, const double*, const int* roots) {

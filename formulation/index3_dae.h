@@ -38,6 +38,8 @@ class Index3Dae : public DaeProblem {
   void switches(double t, const double* y, double* g) override;
   void restart(double t, double* y, double* yp, const int* roots_found) override;
   bool changes_mode(double t, const double* y, const int* roots_found) override;
+  // First backward-Euler step whose local error h^2/2 |q''| is about the tolerance.
+  double initial_step(double t, const double* y, const double* yp, double rtol, double atol) override;
   std::vector<double> breakpoints() const override { return sys_.breakpoints(); }
   void after_step(double t, const double* y) override;
   void set_segment(double t_start, double t_end) override { segment_end_ = t_end; }

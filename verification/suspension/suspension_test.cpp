@@ -165,29 +165,28 @@ double max_difference(const RunOutcome& a, const RunOutcome& b, const std::strin
   return m;
 }
 
+// Tolerance ladder tau = 1e-6, 1e-8, 1e-10 with rtol = tau and atol = 1e-5 tau. The absolute
+// tolerance must be that much tighter because the step size is set by Euler parameters of the
+// rods that pass through zero (their error test is then purely absolute); see docs/results.md.
 TEST(Suspension, GroundStepConvergesWithTheTolerance) {
-  const RunOutcome r6 = run("dynamics_step.yaml", 1e-6, 1e-8);
-  const RunOutcome r8 = run("dynamics_step.yaml", 1e-8, 1e-10);
-  const RunOutcome r10 = run("dynamics_step.yaml", 1e-10, 1e-12);
-  const RunOutcome r12 = run("dynamics_step.yaml", 1e-12, 1e-14);
-  const double e6 = max_difference(r6, r12, "wheel_z"), e8 = max_difference(r8, r12, "wheel_z");
-  const double e10 = max_difference(r10, r12, "wheel_z");
-  RecordProperty("wheel_z_error_1e-6", std::to_string(e6));
-  RecordProperty("wheel_z_error_1e-8", std::to_string(e8));
-  RecordProperty("wheel_z_error_1e-10", std::to_string(e10));
-  // Tolerance proportionality: each factor 100 in tolerance buys at least a factor 10 here
-  // (the ideal is 100; event location and order changes blur it).
-  EXPECT_GT(e6 / e8, 10.0);
-  EXPECT_GT(e8 / e10, 10.0);
-  EXPECT_LT(max_difference(r8, r10, "wheel_z"), 1e-7);
+  const RunOutcome r6 = run("dynamics_step.yaml", 1e-6, 1e-11);
+  const RunOutcome r8 = run("dynamics_step.yaml", 1e-8, 1e-13);
+  const RunOutcome r10 = run("dynamics_step.yaml", 1e-10, 1e-15);
+  const double e6 = max_difference(r6, r10, "wheel_z"), e8 = max_difference(r8, r10, "wheel_z");
+  RecordProperty("wheel_z_difference_1e-6_1e-10", std::to_string(e6));
+  RecordProperty("wheel_z_difference_1e-8_1e-10", std::to_string(e8));
+  // Tolerance proportionality: a factor 100 in tolerance buys a factor of more than 30 here
+  // (ideally 100; event location and order changes blur it).
+  EXPECT_GT(e6 / e8, 30.0);
+  EXPECT_LT(e8, 1e-7);
   // The scene's default tolerances give wheel_z within 1e-6 m of the tightest run.
   const RunOutcome rd = run("dynamics_step.yaml");
-  EXPECT_LT(max_difference(rd, r12, "wheel_z"), 1e-6);
+  EXPECT_LT(max_difference(rd, r10, "wheel_z"), 1e-6);
   // Events converge too: the same count, times within 1e-6 s.
-  const json& ev12 = step_of(r12, "dynamics")["event_times"];
+  const json& ev10 = step_of(r10, "dynamics")["event_times"];
   const json& ev8 = step_of(r8, "dynamics")["event_times"];
-  ASSERT_EQ(ev8.size(), ev12.size());
-  for (size_t i = 0; i < ev8.size(); ++i) EXPECT_NEAR(ev8[i].get<double>(), ev12[i].get<double>(), 1e-6);
+  ASSERT_EQ(ev8.size(), ev10.size());
+  for (size_t i = 0; i < ev8.size(); ++i) EXPECT_NEAR(ev8[i].get<double>(), ev10[i].get<double>(), 1e-6);
 }
 
 }  // namespace
