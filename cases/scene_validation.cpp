@@ -93,6 +93,9 @@ struct Validator {
   const FieldLines& lines;
   std::vector<SceneIssue>& issues;
 
+  Validator(const Scene& s, const FieldLines& l, std::vector<SceneIssue>& out)
+      : scene(s), m(s.model), lines(l), issues(out) {}
+
   std::map<std::string, const BodySpec*> bodies;
   std::map<std::string, const JointSpec*> joint_of_child;       // the tree joint of each body
   std::map<std::string, const JointSpec*> joint_of_coordinate;  // coordinates used by joints
@@ -254,6 +257,10 @@ struct Validator {
   // Orders the tree from ground outwards, reports loops and bodies without a path to ground,
   // and finds which bodies are merged together by locked or welded joints.
   void check_tree() {
+    // A joint whose child is missing or unknown probably was the tree joint of a body reported
+    // below as having none: report that body only if no such joint exists.
+    bool broken_child = false;
+    for (const auto& j : m.joints) broken_child = broken_child || !bodies.count(j.child);
     std::vector<const JointSpec*> order;
     for (bool progress = true; progress;) {
       progress = false;
@@ -317,8 +324,9 @@ struct Validator {
       const Cause& c = causes.at(key);
       std::string also;
       for (const auto& n : c.cut_off) also += (also.empty() ? "" : ", ") + ("'" + n + "'");
-      if (!also.empty()) also = "; nor do the bodies attached to it: " + also;
+      if (!also.empty()) also = "; bodies hanging from " + std::string(c.loop.empty() ? "it" : "them") + " have none either: " + also;
       if (c.loop.empty()) {
+        if (broken_child) continue;
         report(bodies.at(c.root)->where, "name",
                "body '" + c.root + "' has no joint to a parent (no path to ground)" + also);
         continue;
@@ -566,7 +574,7 @@ struct Validator {
 }  // namespace
 
 void validate_scene(const Scene& scene, const FieldLines& lines, std::vector<SceneIssue>& issues) {
-  Validator v{scene, scene.model, lines, issues};
+  Validator v(scene, lines, issues);
   v.check_bodies();
   v.check_joints();
   v.check_tree();

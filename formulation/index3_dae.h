@@ -76,7 +76,7 @@ class Index3Dae : public DaeProblem {
   std::vector<int> switch_forces_;
   SparseAssembler asm_;
   AugmentedSolver aug_;
-  std::vector<double> work_;
+  std::vector<double> work_, out_phi_, out_phi2_;
 };
 
 }  // namespace mbdae

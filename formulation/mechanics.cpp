@@ -98,17 +98,46 @@ void constraint_rates(const System& sys, const std::vector<int>& off, const doub
                       const double* v, double t, double* phi_t, double* gamma) {
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
-    const LocalState s = gather(q, c.bi, c.bj);
-    const Vec14 vl = gather_local(v, c.bi, c.bj);
     double pt[3], ptt[3];
     constraint_time_derivatives(c, t, pt, ptt);
-    for (int r = 0; r < c.rows(); ++r) {
-      double w[3] = {0, 0, 0};
-      w[r] = 1.0;
-      Mat14 h = Mat14::Zero();
-      constraint_hessian(c, s, w, h);
-      if (phi_t) phi_t[off[k] + r] = pt[r];
-      if (gamma) gamma[off[k] + r] = -vl.dot(h * vl) - ptt[r];
+    if (phi_t)
+      for (int r = 0; r < c.rows(); ++r) phi_t[off[k] + r] = pt[r];
+    if (!gamma) continue;
+    // gamma = -qdot^T Phi_qq qdot - Phi_tt. Closed forms for the common primitives, using
+    // B(p', s) p' = d2(A s)/dt2 at p'' = 0; the Hessian for the others.
+    const LocalState s = gather(q, c.bi, c.bj), sv = gather(v, c.bi, c.bj);
+    auto quad = [](int b, const Vec4& pd, const Vec3& x) -> Vec3 {
+      return b < 0 ? Vec3::Zero() : Vec3(B_matrix(pd, x) * pd);
+    };
+    auto rate = [](int b, const Vec4& p, const Vec4& pd, const Vec3& x) -> Vec3 {
+      return b < 0 ? Vec3::Zero() : Vec3(B_matrix(p, x) * pd);
+    };
+    auto world = [](int b, const Vec4& p, const Vec3& x) -> Vec3 { return b < 0 ? x : rotate(p, x); };
+    double* g = gamma + off[k];
+    switch (c.type) {
+      case Constraint::Type::kNorm: g[0] = -2.0 * sv.pi.squaredNorm() - ptt[0]; break;
+      case Constraint::Type::kPoint: {
+        const Vec3 h = quad(c.bi, sv.pi, c.si) - quad(c.bj, sv.pj, c.sj);
+        for (int r = 0; r < 3; ++r) g[r] = -h[r] - ptt[r];
+        break;
+      }
+      case Constraint::Type::kDot1: {
+        const Vec3 u = world(c.bi, s.pi, c.ai), w = world(c.bj, s.pj, c.aj);
+        const double h = quad(c.bi, sv.pi, c.ai).dot(w) + u.dot(quad(c.bj, sv.pj, c.aj)) +
+                         2.0 * rate(c.bi, s.pi, sv.pi, c.ai).dot(rate(c.bj, s.pj, sv.pj, c.aj));
+        g[0] = -h - ptt[0];
+        break;
+      }
+      default: {
+        const Vec14 vl = gather_local(v, c.bi, c.bj);
+        for (int r = 0; r < c.rows(); ++r) {
+          double w[3] = {0, 0, 0};
+          w[r] = 1.0;
+          Mat14 h = Mat14::Zero();
+          constraint_hessian(c, s, w, h);
+          g[r] = -vl.dot(h * vl) - ptt[r];
+        }
+      }
     }
   }
 }

@@ -187,6 +187,30 @@ TEST(JacobianFd, ConstraintGradientsAndHessians) {
   for (int t = 0; t < 6; ++t) EXPECT_GT(checked[t], 0) << "constraint type " << t << " not exercised";
 }
 
+// gamma = -d2Phi/dt2 along q(t) = q + v t (q'' = 0), by a central second difference in time.
+TEST(JacobianFd, AccelerationRightSide) {
+  const System sys = build_system(all_types_model());
+  const RandomState st = random_state(sys, 4);
+  const std::vector<int> off = constraint_offsets(sys);
+  const int nc = off.back(), nq = sys.nq();
+  std::vector<double> gamma(nc), phi_t(nc), pp(nc), p0(nc), pm(nc), qp(nq), qm(nq);
+  const double t = 0.37, eps = 1e-4;
+  constraint_rates(sys, off, st.q.data(), st.v.data(), t, phi_t.data(), gamma.data());
+  for (int i = 0; i < nq; ++i) {
+    qp[i] = st.q[i] + eps * st.v[i];
+    qm[i] = st.q[i] - eps * st.v[i];
+  }
+  constraint_values(sys, off, qp.data(), t + eps, pp.data());
+  constraint_values(sys, off, st.q.data(), t, p0.data());
+  constraint_values(sys, off, qm.data(), t - eps, pm.data());
+  for (size_t k = 0; k < sys.constraints.size(); ++k)
+    for (int r = 0; r < sys.constraints[k].rows(); ++r) {
+      const int i = off[k] + r;
+      const double fd = -(pp[i] - 2 * p0[i] + pm[i]) / (eps * eps);
+      EXPECT_NEAR(gamma[i], fd, 1e-5 * (1 + std::fabs(fd))) << sys.constraints[k].label;
+    }
+}
+
 TEST(JacobianFd, ForceJacobians) {
   const System sys = build_system(all_types_model());
   const RandomState st = random_state(sys, 2);
