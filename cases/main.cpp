@@ -9,6 +9,7 @@
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "core/errors.h"
+#include "formulation/system.h"
 
 namespace {
 void usage() {
@@ -58,7 +59,9 @@ int main(int argc, char** argv) {
   try {
     const mbdae::Scene scene = mbdae::load_scene(scene_path);
     if (check_only) {
-      std::printf("%s: ok\n", scene_path.c_str());
+      const mbdae::System sys = mbdae::build_system(scene.model);
+      std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", scene_path.c_str(),
+                  sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
     const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);

@@ -220,6 +220,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         io.atol = opt.atol > 0 ? opt.atol : step.atol;
         io.output_step = step.output_step;
         io.max_step = step.max_step;
+        io.nonlinear_convergence = step.newton_convergence;
+        js["newton_convergence"] = io.nonlinear_convergence;
         js["rtol"] = io.rtol;
         js["atol"] = io.atol;
         const double scale = step.constraint_scale > 0 ? step.constraint_scale : automatic_constraint_scale(sys, step);

@@ -15,6 +15,7 @@ struct AnalysisStep {
   double t0 = 0, t_end = 1, output_step = 0.01;
   double rtol = 1e-6, atol = 1e-8, max_step = 0;
   double constraint_scale = 0;  // 0: automatic
+  double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
   std::string formulation = "index3";
   // Report the largest change of these sensors before this time ("nothing moves before").
   double quiet_until = -1;

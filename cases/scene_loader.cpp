@@ -1,14 +1,22 @@
 // YAML scene loader. Every problem is recorded with its file, line and field, and loading goes
-// on so that all problems of a file are reported at once.
+// on so that all problems of a file are reported at once: first what can be seen field by field
+// (unknown or missing fields, wrong types, numbers that are not finite or out of range), then
+// the references between items and the joint tree (validate_scene, cases/scene_validation.cpp).
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "cases/scene.h"
+#include "cases/scene_validation.h"
 #include "core/errors.h"
 
 namespace mbdae {
@@ -24,65 +32,147 @@ SceneError::SceneError(std::vector<std::string> m)
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr std::size_t kMaxFileBytes = 16u << 20;  // scene and model files
+constexpr double kMaxOutputRows = 1e8;
+
+using Fields = std::vector<std::string>;
+
+bool contains(const Fields& list, const std::string& s) { return std::find(list.begin(), list.end(), s) != list.end(); }
+std::string join(const Fields& list) {
+  std::string s;
+  for (const auto& x : list) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+// A scalar as shown in a message: quoted, control characters escaped, long text shortened.
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (k == 60) {
+      out += "...";
+      break;
+    }
+    const unsigned char c = static_cast<unsigned char>(s[k]);
+    if (c < 0x20 || c == 0x7f) {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "'";
+}
+std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsMap()) return "a mapping";
+  if (n.IsSequence()) return "a list of " + std::to_string(n.size());
+  return quote(n.Scalar());
+}
+std::string format_number(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
 
 struct Loader {
   std::string file;
-  std::vector<std::string>* errors;
+  std::vector<SceneIssue>* issues;
+  FieldLines* lines;
 
-  SourceLocation where(const YAML::Node& n) const {
-    return SourceLocation{file, n.Mark().line >= 0 ? n.Mark().line + 1 : 0};
+  static int line_of(const YAML::Node& n) {
+    if (!n.IsDefined()) return 0;
+    const int l = n.Mark().line;
+    return l >= 0 ? l + 1 : 0;
+  }
+  SourceLocation where(const YAML::Node& n) const { return SourceLocation{file, line_of(n)}; }
+  void error_at(int line, const std::string& field, const std::string& msg) {
+    issues->push_back({file, line, field, msg});
   }
   void error(const YAML::Node& n, const std::string& field, const std::string& msg) {
-    const SourceLocation w = where(n);
-    errors->push_back(ModelError::format(w.file, w.line, field, msg));
+    error_at(line_of(n), field, msg);
   }
-  // Reports keys of a mapping that are not in `allowed`.
-  bool check_keys(const YAML::Node& n, const std::string& what, std::initializer_list<const char*> allowed) {
+  bool has(const YAML::Node& n, const char* key) const { return n.IsMap() && n[key]; }
+  // The value of `key`, or `parent` itself if absent (to place a message).
+  YAML::Node at(const YAML::Node& parent, const char* key) const {
+    return has(parent, key) ? YAML::Node(parent[key]) : parent;
+  }
+  void record(const YAML::Node& item, const std::string& field, const YAML::Node& value) {
+    lines->add(where(item), field, line_of(value));
+  }
+
+  std::optional<std::string> key_of(const YAML::Node& k, const std::string& what) {
+    if (k.IsScalar()) return k.Scalar();
+    error(k, what, "expected a name as key, got " + describe(k));
+    return std::nullopt;
+  }
+  // Reports keys of a mapping that are not in `allowed`, or given twice.
+  bool check_keys(const YAML::Node& n, const std::string& what, const Fields& allowed) {
     if (!n.IsMap()) {
-      error(n, what, "expected a mapping");
+      error(n, what, "expected a mapping, got " + describe(n));
       return false;
     }
+    std::set<std::string> seen;
     for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
-      bool ok = false;
-      for (const char* a : allowed) ok = ok || key == a;
-      if (!ok) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        error(kv.first, key, "unknown field in " + what + " (expected one of: " + list + ")");
-      }
+      const auto key = key_of(kv.first, what);
+      if (!key) continue;
+      if (!seen.insert(*key).second) error(kv.first, *key, "given twice in " + what);
+      else if (!contains(allowed, *key))
+        error(kv.first, *key, "unknown field in " + what + " (expected one of: " + join(allowed) + ")" +
+                                  did_you_mean(*key, allowed));
     }
     return true;
   }
-  bool has(const YAML::Node& n, const char* key) const { return n.IsMap() && n[key]; }
+  // Reports known fields (in `general`) that have no effect for this type (not in `specific`).
+  void applies(const YAML::Node& n, const std::string& what, const Fields& general, const Fields& specific) {
+    if (!n.IsMap()) return;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) continue;
+      const std::string& key = kv.first.Scalar();
+      if (contains(general, key) && !contains(specific, key))
+        error(kv.first, key, "does not apply to " + what + " (its fields: " + join(specific) + ")");
+    }
+  }
 
-  double number(const YAML::Node& parent, const char* key, double fallback, bool required = false) {
+  std::optional<double> to_number(const YAML::Node& v, const std::string& field) {
+    if (!v.IsScalar()) {
+      error(v, field, "expected a number, got " + describe(v));
+      return std::nullopt;
+    }
+    const std::string& s = v.Scalar();
+    std::string low;
+    for (char c : s) low += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (low == ".nan" || low == ".inf" || low == "+.inf" || low == "-.inf") {
+      error(v, field, quote(s) + " is not a finite number");
+      return std::nullopt;
+    }
+    if (s.empty() || std::isspace(static_cast<unsigned char>(s[0]))) {
+      error(v, field, "expected a number, got " + quote(s));
+      return std::nullopt;
+    }
+    char* end = nullptr;
+    const double x = std::strtod(s.c_str(), &end);
+    if (end != s.c_str() + s.size()) {
+      error(v, field, "expected a number, got " + quote(s));
+      return std::nullopt;
+    }
+    if (!std::isfinite(x)) {
+      error(v, field, quote(s) + " is not a finite number");
+      return std::nullopt;
+    }
+    return x;
+  }
+  std::optional<double> opt_number(const YAML::Node& parent, const char* key, bool required = false) {
     if (!has(parent, key)) {
       if (required) error(parent, key, "missing");
-      return fallback;
+      return std::nullopt;
     }
     const YAML::Node v = parent[key];
-    return as_number(v, key, fallback);
+    record(parent, key, v);
+    return to_number(v, key);
   }
-  double as_number(const YAML::Node& v, const std::string& field, double fallback) {
-    if (!v.IsScalar()) {
-      error(v, field, "expected a number");
-      return fallback;
-    }
-    const std::string s = v.Scalar();
-    try {
-      size_t used = 0;
-      const double x = std::stod(s, &used);
-      if (used != s.size()) throw std::invalid_argument(s);
-      if (!std::isfinite(x)) {
-        error(v, field, "'" + s + "' is not a finite number");
-        return fallback;
-      }
-      return x;
-    } catch (const std::exception&) {
-      error(v, field, "expected a number, got '" + s + "'");
-      return fallback;
-    }
+  double number(const YAML::Node& parent, const char* key, double fallback, bool required = false) {
+    return opt_number(parent, key, required).value_or(fallback);
   }
   std::string text(const YAML::Node& parent, const char* key, const std::string& fallback, bool required = false) {
     if (!has(parent, key)) {
@@ -90,11 +180,22 @@ struct Loader {
       return fallback;
     }
     const YAML::Node v = parent[key];
+    record(parent, key, v);
     if (!v.IsScalar()) {
-      error(v, key, "expected text");
+      error(v, key, "expected text, got " + describe(v));
       return fallback;
     }
     return v.Scalar();
+  }
+  // A required name (of the item, or of another item it refers to).
+  std::string name(const YAML::Node& parent, const char* key = "name") {
+    const std::string s = text(parent, key, "", true);
+    if (has(parent, key) && parent[key].IsScalar()) {
+      if (s.empty()) error(parent[key], key, "must not be empty");
+      else if (std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        error(parent[key], key, "must not contain control characters, got " + quote(s));
+    }
+    return s;
   }
   Vec3 vec3(const YAML::Node& parent, const char* key, const Vec3& fallback, bool required = false) {
     if (!has(parent, key)) {
@@ -102,26 +203,32 @@ struct Loader {
       return fallback;
     }
     const YAML::Node v = parent[key];
+    record(parent, key, v);
     if (!v.IsSequence() || v.size() != 3) {
-      error(v, key, "expected a list of 3 numbers");
+      error(v, key, "expected a list of 3 numbers, got " + describe(v));
       return fallback;
     }
     Vec3 out;
-    for (int k = 0; k < 3; ++k) out[k] = as_number(v[k], key, fallback[k]);
+    for (int k = 0; k < 3; ++k) out[k] = to_number(v[k], key).value_or(fallback[k]);
     return out;
   }
   std::vector<std::string> names(const YAML::Node& parent, const char* key) {
     std::vector<std::string> out;
     if (!has(parent, key)) return out;
     const YAML::Node v = parent[key];
+    record(parent, key, v);
     if (v.IsScalar()) return {v.Scalar()};
     if (!v.IsSequence()) {
-      error(v, key, "expected a list of names");
+      error(v, key, "expected a list of names, got " + describe(v));
       return out;
     }
     for (const auto& x : v) {
-      if (!x.IsScalar()) error(x, key, "expected a name");
-      else out.push_back(x.Scalar());
+      if (!x.IsScalar()) {
+        error(x, key, "expected a name, got " + describe(x));
+        continue;
+      }
+      lines->add(where(parent), std::string(key) + "[" + std::to_string(out.size()) + "]", line_of(x));
+      out.push_back(x.Scalar());
     }
     return out;
   }
@@ -130,113 +237,169 @@ struct Loader {
     if (c == "x") return 0;
     if (c == "y") return 1;
     if (c == "z") return 2;
-    error(parent[key], key, "expected x, y or z");
+    if (parent[key].IsScalar()) error(parent[key], key, "expected x, y or z, got " + quote(c));
     return 0;
   }
 
   TimeFunction function(const YAML::Node& n, const std::string& field) {
     TimeFunction f;
-    if (n.IsScalar()) return TimeFunction::constant(as_number(n, field, 0.0));
-    if (!check_keys(n, field, {"type", "value", "time", "before", "after", "points", "amplitude",
-                               "frequency", "phase", "offset", "f0", "f1", "t0", "t1", "coefficients"}))
-      return f;
+    if (n.IsScalar()) return TimeFunction::constant(to_number(n, field).value_or(0.0));
+    static const Fields general = {"type", "value", "time", "before", "after", "points", "amplitude",
+                                   "frequency", "phase", "offset", "f0", "f1", "t0", "t1", "coefficients"};
+    if (!check_keys(n, field, general)) return f;
     const std::string type = text(n, "type", "", true);
+    const std::string what = "a " + type + " function";
     if (type == "constant") {
+      applies(n, what, general, {"type", "value"});
       f.a = number(n, "value", 0.0, true);
     } else if (type == "step") {
+      applies(n, what, general, {"type", "time", "before", "after"});
       f.kind = TimeFunction::Kind::kStep;
       f.t0 = number(n, "time", 0.0, true);
       f.a = number(n, "before", 0.0, true);
       f.b = number(n, "after", 0.0, true);
     } else if (type == "piecewise_linear") {
+      applies(n, what, general, {"type", "points"});
       f.kind = TimeFunction::Kind::kPiecewiseLinear;
-      const YAML::Node pts = n["points"];
-      if (!pts || !pts.IsSequence() || pts.size() < 2) {
-        error(n, "points", "expected at least two [t, value] pairs");
+      const YAML::Node pts = at(n, "points");
+      if (!has(n, "points") || !pts.IsSequence() || pts.size() < 2) {
+        error(pts, "points", "expected at least two [t, value] pairs");
         return TimeFunction{};
       }
       for (const auto& p : pts) {
         if (!p.IsSequence() || p.size() != 2) {
-          error(p, "points", "expected a [t, value] pair");
+          error(p, "points", "expected a [t, value] pair, got " + describe(p));
           continue;
         }
-        f.ts.push_back(as_number(p[0], "points", 0.0));
-        f.ys.push_back(as_number(p[1], "points", 0.0));
-        if (f.ts.size() > 1 && !(f.ts.back() > f.ts[f.ts.size() - 2]))
-          error(p, "points", "times must increase");
+        const auto t = to_number(p[0], "points"), y = to_number(p[1], "points");
+        if (!t || !y) continue;
+        if (!f.ts.empty() && !(*t > f.ts.back())) error(p, "points", "times must increase");
+        f.ts.push_back(*t);
+        f.ys.push_back(*y);
       }
+      if (f.ts.size() < 2) return TimeFunction{};
     } else if (type == "sine") {
+      applies(n, what, general, {"type", "amplitude", "frequency", "phase", "offset"});
       f.kind = TimeFunction::Kind::kSine;
       f.a = number(n, "amplitude", 0.0, true);
       f.b = number(n, "frequency", 0.0, true);
       f.c = number(n, "phase", 0.0);
       f.d = number(n, "offset", 0.0);
     } else if (type == "sweep") {
+      applies(n, what, general, {"type", "amplitude", "f0", "f1", "t0", "t1"});
       f.kind = TimeFunction::Kind::kSweep;
       f.a = number(n, "amplitude", 0.0, true);
       f.b = number(n, "f0", 0.0, true);
       f.c = number(n, "f1", 0.0, true);
-      f.t0 = number(n, "t0", 0.0);
-      f.t1 = number(n, "t1", 1.0, true);
-      if (!(f.t1 > f.t0)) error(n, "t1", "must be after t0");
+      const auto t0 = opt_number(n, "t0"), t1 = opt_number(n, "t1", true);
+      f.t0 = t0.value_or(0.0);
+      f.t1 = t1.value_or(1.0);
+      if (t1 && !(f.t1 > f.t0)) error(n["t1"], "t1", "the sweep's time span is empty (t1 must exceed t0)");
     } else if (type == "polynomial") {
+      applies(n, what, general, {"type", "coefficients"});
       f.kind = TimeFunction::Kind::kPolynomial;
-      const YAML::Node c = n["coefficients"];
-      if (!c || !c.IsSequence() || c.size() == 0) error(n, "coefficients", "expected a list of numbers");
-      else for (const auto& x : c) f.ys.push_back(as_number(x, "coefficients", 0.0));
+      const YAML::Node c = at(n, "coefficients");
+      if (!has(n, "coefficients") || !c.IsSequence() || c.size() == 0)
+        error(c, "coefficients", "expected a list of numbers");
+      else
+        for (const auto& x : c) f.ys.push_back(to_number(x, "coefficients").value_or(0.0));
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown function type '" + type +
-                                   "' (constant, step, piecewise_linear, sine, sweep, polynomial)");
+      error(n["type"], "type", "unknown function type " + quote(type) +
+                                   " (constant, step, piecewise_linear, sine, sweep, polynomial)");
     }
     return f;
+  }
+
+  void inertia(const YAML::Node& in, BodySpec& b) {
+    bool ok = true;
+    if (in.IsMap()) {
+      check_keys(in, "inertia", {"xx", "yy", "zz", "xy", "yz", "xz"});
+      double v[6];
+      const char* keys[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+      for (int k = 0; k < 6; ++k) {
+        const auto x = opt_number(in, keys[k]);
+        if (has(in, keys[k]) && !x) ok = false;
+        v[k] = x.value_or(0.0);
+      }
+      b.inertia << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
+    } else if (in.IsSequence() && in.size() == 3) {
+      for (int r = 0; r < 3; ++r) {
+        if (!in[r].IsSequence() || in[r].size() != 3) {
+          error(in[r], "inertia", "expected a row of 3 numbers, got " + describe(in[r]));
+          ok = false;
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const auto x = to_number(in[r][c], "inertia");
+          ok = ok && x.has_value();
+          b.inertia(r, c) = x.value_or(0.0);
+        }
+      }
+      if (ok && (b.inertia - b.inertia.transpose()).cwiseAbs().maxCoeff() >
+                    1e-12 * (1 + b.inertia.cwiseAbs().maxCoeff())) {
+        error(in, "inertia", "the inertia tensor is not symmetric");
+        ok = false;
+      }
+    } else {
+      error(in, "inertia", "expected {xx, yy, zz, xy, yz, xz} or a 3x3 matrix, got " + describe(in));
+      ok = false;
+    }
+    if (!ok) return;
+    Eigen::SelfAdjointEigenSolver<Mat3> es(b.inertia, Eigen::EigenvaluesOnly);
+    const Vec3 ev = es.eigenvalues();
+    const double tol = 1e-12 * std::max(1.0, ev.cwiseAbs().maxCoeff());
+    if (!ev.allFinite())
+      error(in, "inertia", "the inertia tensor is too large");
+    else if (ev.minCoeff() < -tol)
+      error(in, "inertia", "the inertia tensor is not positive semi-definite (smallest principal moment " +
+                               format_number(ev.minCoeff()) + ")");
+    else if (ev[0] + ev[1] < ev[2] - tol)
+      error(in, "inertia", "the principal moments violate the triangle inequality (not a rigid body)");
   }
 
   void body(const YAML::Node& n, Model& m) {
     if (!check_keys(n, "body", {"name", "mass", "com", "inertia", "points"})) return;
     BodySpec b;
     b.where = where(n);
-    b.name = text(n, "name", "", true);
-    b.mass = number(n, "mass", 0.0, true);
-    if (has(n, "mass") && !(b.mass > 0)) error(n["mass"], "mass", "must be positive");
+    b.name = name(n);
+    if (const auto mass = opt_number(n, "mass", true)) {
+      b.mass = *mass;
+      if (!(b.mass > 0)) error(n["mass"], "mass", "must be positive, got " + format_number(b.mass));
+    }
     b.com = vec3(n, "com", Vec3::Zero());
     if (has(n, "inertia")) {
-      const YAML::Node in = n["inertia"];
-      if (in.IsMap()) {
-        check_keys(in, "inertia", {"xx", "yy", "zz", "xy", "yz", "xz"});
-        const double xx = number(in, "xx", 0), yy = number(in, "yy", 0), zz = number(in, "zz", 0);
-        const double xy = number(in, "xy", 0), yz = number(in, "yz", 0), xz = number(in, "xz", 0);
-        b.inertia << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-      } else if (in.IsSequence() && in.size() == 3 && in[0].IsSequence()) {
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) b.inertia(r, c) = in[r].size() == 3 ? as_number(in[r][c], "inertia", 0) : 0;
-        if ((b.inertia - b.inertia.transpose()).cwiseAbs().maxCoeff() > 1e-12 * (1 + b.inertia.cwiseAbs().maxCoeff()))
-          error(in, "inertia", "the inertia tensor is not symmetric");
-      } else {
-        error(in, "inertia", "expected {xx, yy, zz, xy, yz, xz} or a 3x3 matrix");
-      }
-      Eigen::SelfAdjointEigenSolver<Mat3> es(b.inertia);
-      const Vec3 ev = es.eigenvalues();
-      const double tol = 1e-12 * std::max(1.0, ev.cwiseAbs().maxCoeff());
-      if (ev.minCoeff() < -tol) error(in, "inertia", "the inertia tensor is not positive semi-definite");
-      else if (ev[0] + ev[1] < ev[2] - tol)
-        error(in, "inertia", "the principal moments violate the triangle inequality (not a rigid body)");
+      record(n, "inertia", n["inertia"]);
+      inertia(n["inertia"], b);
     }
     if (has(n, "points")) {
       const YAML::Node pts = n["points"];
-      if (!pts.IsMap()) error(pts, "points", "expected a mapping name: [x, y, z]");
-      else
+      record(n, "points", pts);
+      if (!pts.IsMap()) {
+        error(pts, "points", "expected a mapping name: [x, y, z], got " + describe(pts));
+      } else {
         for (const auto& kv : pts) {
-          const std::string pname = kv.first.as<std::string>();
-          YAML::Node holder;
-          holder[pname] = kv.second;
+          const auto pname = key_of(kv.first, "points");
+          if (!pname) continue;
+          const std::string field = "points." + *pname;
+          if (*pname == "origin" || *pname == "com" || pname->empty()) {
+            error(kv.first, field, pname->empty() ? "a point needs a name"
+                                   : *pname == "com" ? "'com' is reserved (the centre of mass)"
+                                                     : "'origin' is reserved (the origin of the body frame)");
+            continue;
+          }
+          if (b.points.count(*pname)) {
+            error(kv.first, field, "given twice");
+            continue;
+          }
           if (!kv.second.IsSequence() || kv.second.size() != 3) {
-            error(kv.second, "points." + pname, "expected a list of 3 numbers");
+            error(kv.second, field, "expected a list of 3 numbers, got " + describe(kv.second));
             continue;
           }
           Vec3 p;
-          for (int k = 0; k < 3; ++k) p[k] = as_number(kv.second[k], "points." + pname, 0.0);
-          b.points[pname] = p;
+          for (int k = 0; k < 3; ++k) p[k] = to_number(kv.second[k], field).value_or(0.0);
+          b.points[*pname] = p;
         }
+      }
     }
     m.bodies.push_back(b);
   }
@@ -245,142 +408,197 @@ struct Loader {
     if (!check_keys(n, "joint", {"name", "parent", "child", "anchor", "chain", "coordinates"})) return;
     JointSpec j;
     j.where = where(n);
-    j.name = text(n, "name", "", true);
-    j.parent = text(n, "parent", "", true);
-    j.child = text(n, "child", "", true);
+    j.name = name(n);
+    j.parent = name(n, "parent");
+    j.child = name(n, "child");
     if (has(n, "anchor")) {
-      if (n["anchor"].IsScalar()) j.anchor_point = n["anchor"].Scalar();
-      else j.anchor = vec3(n, "anchor", Vec3::Zero());
+      const YAML::Node a = n["anchor"];
+      if (a.IsScalar()) {
+        record(n, "anchor", a);
+        j.anchor_point = a.Scalar();
+        if (j.anchor_point.empty()) error(a, "anchor", "expected a point name or [x, y, z]");
+      } else {
+        j.anchor = vec3(n, "anchor", Vec3::Zero());
+      }
     }
     const std::vector<std::string> chain = names(n, "chain");
     const std::vector<std::string> coords = names(n, "coordinates");
     if (coords.size() != chain.size())
-      error(n, "coordinates", "expected one coordinate name per elementary joint of the chain (" +
-                                  std::to_string(chain.size()) + ")");
+      error(at(n, "coordinates"), "coordinates",
+            "expected one coordinate name per elementary joint of the chain (" + std::to_string(chain.size()) +
+                ", got " + std::to_string(coords.size()) + ")");
     for (size_t k = 0; k < chain.size(); ++k) {
       const std::string& e = chain[k];
       ElementaryJoint ej;
       if (e.size() != 2 || (e[0] != 'R' && e[0] != 'T') || e[1] < '1' || e[1] > '3') {
-        error(n["chain"], "chain", "unknown elementary joint '" + e + "' (R1 R2 R3 T1 T2 T3)");
+        error_at(lines->line(j.where, "chain[" + std::to_string(k) + "]"), "chain",
+                 "unknown elementary joint " + quote(e) + " (R1 R2 R3 T1 T2 T3)");
         continue;
       }
       ej.rotation = e[0] == 'R';
       ej.axis = e[1] - '1';
       ej.coordinate = k < coords.size() ? coords[k] : "";
+      if (k < coords.size() && coords[k].empty())
+        error_at(lines->line(j.where, "coordinates[" + std::to_string(k) + "]"), "coordinates",
+                 "a coordinate name must not be empty");
       j.chain.push_back(ej);
     }
     m.joints.push_back(j);
   }
 
-  void coordinate(const std::string& name, const YAML::Node& n, Model& m, bool patch) {
-    if (!check_keys(n, "coordinate " + name, {"initial", "initial_deg", "mode", "drive"})) return;
+  void coordinate(const std::string& name, const YAML::Node& key, const YAML::Node& n, Model& m, bool patch) {
+    const std::string field = "coordinates." + name;
+    if (!check_keys(n, "coordinate " + quote(name), {"initial", "initial_deg", "mode", "drive"})) return;
     CoordinateSpec c;
     auto it = m.coordinates.find(name);
-    if (patch && it != m.coordinates.end()) c = it->second;
+    const bool patching = patch && it != m.coordinates.end();
+    if (patching) c = it->second;
     c.name = name;
     c.where = where(n);
-    if (has(n, "initial")) c.initial = number(n, "initial", 0.0);
-    if (has(n, "initial_deg")) c.initial = number(n, "initial_deg", 0.0) * kDeg;
+    lines->add(c.where, "name", line_of(key));
+    if (has(n, "initial") && has(n, "initial_deg")) error(n["initial_deg"], "initial_deg", "give initial or initial_deg, not both");
+    if (has(n, "initial")) c.initial = number(n, "initial", c.initial);
+    else if (has(n, "initial_deg")) c.initial = number(n, "initial_deg", c.initial / kDeg) * kDeg;
     if (has(n, "mode")) {
       const std::string mode = text(n, "mode", "free");
       if (mode == "free") c.mode = CoordinateSpec::Mode::kFree;
       else if (mode == "locked") c.mode = CoordinateSpec::Mode::kLocked;
       else if (mode == "driven") c.mode = CoordinateSpec::Mode::kDriven;
-      else error(n["mode"], "mode", "expected free, locked or driven");
+      else if (n["mode"].IsScalar()) error(n["mode"], "mode", "expected free, locked or driven, got " + quote(mode));
     }
     if (has(n, "drive")) c.drive = function(n["drive"], "drive");
-    if (c.mode == CoordinateSpec::Mode::kDriven && !has(n, "drive") && !(patch && it != m.coordinates.end() && it->second.mode == CoordinateSpec::Mode::kDriven))
+    if (c.mode == CoordinateSpec::Mode::kDriven && !has(n, "drive") &&
+        !(patching && it->second.mode == CoordinateSpec::Mode::kDriven))
       error(n, "drive", "a driven coordinate needs a drive function");
     m.coordinates[name] = c;
   }
 
   void cut(const YAML::Node& n, Model& m) {
-    if (!check_keys(n, "cut", {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "distance"})) return;
+    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "distance"};
+    if (!check_keys(n, "cut", general)) return;
     CutSpec c;
     c.where = where(n);
-    c.name = text(n, "name", "", true);
+    c.name = name(n);
     const std::string type = text(n, "type", "", true);
+    const Fields base = {"name", "type", "body1", "point1", "body2", "point2"};
+    auto with = [&](Fields extra) {
+      Fields f = base;
+      f.insert(f.end(), extra.begin(), extra.end());
+      return f;
+    };
     if (type == "ball") c.type = CutSpec::Type::kBall;
     else if (type == "revolute") c.type = CutSpec::Type::kRevolute;
     else if (type == "universal") c.type = CutSpec::Type::kUniversal;
     else if (type == "prismatic") c.type = CutSpec::Type::kPrismatic;
     else if (type == "weld") c.type = CutSpec::Type::kWeld;
     else if (type == "distance") c.type = CutSpec::Type::kDistance;
-    else if (!type.empty()) error(n["type"], "type", "unknown cut type '" + type + "' (ball, revolute, universal, prismatic, weld, distance)");
-    c.body1 = text(n, "body1", "", true);
-    c.body2 = text(n, "body2", "", true);
+    else if (!type.empty()) error(n["type"], "type", "unknown cut type " + quote(type) + " (ball, revolute, universal, prismatic, weld, distance)");
+    if (type == "ball" || type == "weld") applies(n, "a " + type + " cut", general, base);
+    if (type == "revolute" || type == "universal") applies(n, "a " + type + " cut", general, with({"axis1", "axis2"}));
+    if (type == "prismatic") applies(n, "a prismatic cut", general, with({"axis1"}));
+    if (type == "distance") applies(n, "a distance cut", general, with({"distance"}));
+    c.body1 = name(n, "body1");
+    c.body2 = name(n, "body2");
     c.point1 = text(n, "point1", "");
     c.point2 = text(n, "point2", "");
     c.axis1 = vec3(n, "axis1", Vec3::UnitZ());
     c.axis2 = vec3(n, "axis2", c.axis1);
-    if (c.axis1.norm() == 0) error(n, "axis1", "must not be zero");
-    if (c.axis2.norm() == 0) error(n, "axis2", "must not be zero");
-    c.distance = number(n, "distance", 0.0, c.type == CutSpec::Type::kDistance);
-    if (c.type == CutSpec::Type::kDistance && !(c.distance > 0)) error(n, "distance", "must be positive");
+    if (c.axis1.norm() == 0) error(at(n, "axis1"), "axis1", "must not be zero");
+    if (has(n, "axis2") && c.axis2.norm() == 0) error(at(n, "axis2"), "axis2", "must not be zero");
+    if (c.type == CutSpec::Type::kDistance) {
+      const auto d = opt_number(n, "distance", true);
+      c.distance = d.value_or(0.0);
+      if (d && !(c.distance > 0)) error(n["distance"], "distance", "must be positive, got " + format_number(c.distance));
+    }
     m.cuts.push_back(c);
   }
 
   void force(const YAML::Node& n, Model& m) {
-    if (!check_keys(n, "force", {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
-                                 "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
-                                 "ground", "law", "parameters"}))
-      return;
+    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
+                                   "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
+                                   "ground", "law", "parameters"};
+    if (!check_keys(n, "force", general)) return;
     ForceSpec f;
     f.where = where(n);
-    f.name = text(n, "name", "", true);
+    f.name = name(n);
     const std::string type = text(n, "type", "", true);
+    auto non_negative = [&](const char* key, double& out, bool required) {
+      const auto x = opt_number(n, key, required);
+      if (x) out = *x;
+      if (x && *x < 0) error(n[key], key, "must not be negative, got " + format_number(*x));
+    };
+    auto positive = [&](const char* key, double& out) {
+      const auto x = opt_number(n, key, true);
+      if (x) out = *x;
+      if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
+    };
     if (type == "spring_damper") {
+      applies(n, "a spring_damper force", general,
+              {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"});
       f.type = ForceSpec::Type::kSpringDamper;
-      f.body1 = text(n, "body1", "", true);
+      f.body1 = name(n, "body1");
       f.point1 = text(n, "point1", "");
-      f.body2 = text(n, "body2", "", true);
+      f.body2 = name(n, "body2");
       f.point2 = text(n, "point2", "");
-      f.stiffness = number(n, "stiffness", 0.0, true);
-      f.damping = number(n, "damping", 0.0);
-      f.free_length = number(n, "free_length", 0.0);
-      if (f.stiffness < 0) error(n["stiffness"], "stiffness", "must not be negative");
-      if (f.damping < 0) error(n["damping"], "damping", "must not be negative");
+      non_negative("stiffness", f.stiffness, true);
+      non_negative("damping", f.damping, false);
+      non_negative("free_length", f.free_length, false);
     } else if (type == "point_force") {
+      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz"});
       f.type = ForceSpec::Type::kPointForce;
-      f.body1 = text(n, "body", "", true);
+      f.body1 = name(n, "body");
       f.point1 = text(n, "point", "");
-      if (has(n, "fx")) f.fx = function(n["fx"], "fx");
-      if (has(n, "fy")) f.fy = function(n["fy"], "fy");
-      if (has(n, "fz")) f.fz = function(n["fz"], "fz");
+      for (const char* key : {"fx", "fy", "fz"})
+        if (has(n, key)) {
+          record(n, key, n[key]);
+          (key[1] == 'x' ? f.fx : key[1] == 'y' ? f.fy : f.fz) = function(n[key], key);
+        }
     } else if (type == "wheel_contact") {
+      applies(n, "a wheel_contact force", general,
+              {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"});
       f.type = ForceSpec::Type::kWheelContact;
-      f.body1 = text(n, "body", "", true);
+      f.body1 = name(n, "body");
       f.point1 = text(n, "point", "");
-      f.stiffness = number(n, "stiffness", 0.0, true);
-      f.radius = number(n, "radius", 0.0, true);
+      positive("stiffness", f.stiffness);
+      positive("radius", f.radius);
       f.axis = vec3(n, "axis", Vec3::UnitY());
       if (f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
-      if (!(f.stiffness > 0)) error(n, "stiffness", "must be positive");
-      if (!(f.radius > 0)) error(n, "radius", "must be positive");
       if (has(n, "ground")) f.ground = function(n["ground"], "ground");
     } else if (type == "user") {
+      applies(n, "a user force", general, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"});
       f.type = ForceSpec::Type::kUser;
-      f.body1 = text(n, "body1", "", true);
+      f.body1 = name(n, "body1");
       f.point1 = text(n, "point1", "");
-      f.body2 = text(n, "body2", "", true);
+      f.body2 = name(n, "body2");
       f.point2 = text(n, "point2", "");
-      f.law = text(n, "law", "", true);
+      f.law = name(n, "law");
       if (has(n, "parameters")) {
         const YAML::Node p = n["parameters"];
-        if (!p.IsMap()) error(p, "parameters", "expected a mapping name: number");
-        else for (const auto& kv : p) f.parameters[kv.first.as<std::string>()] = as_number(kv.second, "parameters", 0.0);
+        record(n, "parameters", p);
+        if (!p.IsMap()) {
+          error(p, "parameters", "expected a mapping name: number, got " + describe(p));
+        } else {
+          for (const auto& kv : p) {
+            const auto pname = key_of(kv.first, "parameters");
+            if (!pname) continue;
+            lines->add(f.where, "parameters." + *pname, line_of(kv.first));
+            if (f.parameters.count(*pname)) error(kv.first, "parameters." + *pname, "given twice");
+            else if (const auto x = to_number(kv.second, "parameters." + *pname)) f.parameters[*pname] = *x;
+          }
+        }
       }
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown force type '" + type + "' (spring_damper, point_force, wheel_contact, user)");
+      error(n["type"], "type", "unknown force type " + quote(type) + " (spring_damper, point_force, wheel_contact, user)");
     }
     m.forces.push_back(f);
   }
 
   void sensor(const YAML::Node& n, Model& m) {
-    if (!check_keys(n, "sensor", {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression"})) return;
+    static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression"};
+    if (!check_keys(n, "sensor", general)) return;
     SensorSpec s;
     s.where = where(n);
-    s.name = text(n, "name", "", true);
+    s.name = name(n);
     const std::string type = text(n, "type", "", true);
     using T = SensorSpec::Type;
     static const std::map<std::string, T> types = {
@@ -390,24 +608,44 @@ struct Loader {
         {"kinetic_energy", T::kKineticEnergy}, {"potential_energy", T::kPotentialEnergy}};
     auto it = types.find(type);
     if (it == types.end()) {
-      if (!type.empty()) error(n["type"], "type", "unknown sensor type '" + type + "'");
+      if (!type.empty()) {
+        Fields known;
+        for (const auto& kv : types) known.push_back(kv.first);
+        error(n["type"], "type", "unknown sensor type " + quote(type) + " (" + join(known) + ")" + did_you_mean(type, known));
+      }
       return;
     }
     s.type = it->second;
+    const std::string what = "a " + type + " sensor";
     switch (s.type) {
       case T::kPosition: case T::kVelocity: case T::kAcceleration:
-        s.body = text(n, "body", "", true);
+        applies(n, what, general, {"name", "type", "body", "point", "component"});
+        s.body = name(n, "body");
         s.point = text(n, "point", "");
         s.component = axis_component(n, "component");
         break;
       case T::kAxis:
-        s.body = text(n, "body", "", true);
+        applies(n, what, general, {"name", "type", "body", "axis", "component"});
+        s.body = name(n, "body");
         s.axis = vec3(n, "axis", Vec3::UnitX(), true);
+        if (has(n, "axis") && s.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
         s.component = axis_component(n, "component");
         break;
-      case T::kCoordinate: case T::kCoordinateRate: s.target = text(n, "coordinate", "", true); break;
-      case T::kForceLength: case T::kForceValue: s.target = text(n, "force", "", true); break;
-      case T::kExpression: s.expression = text(n, "expression", "", true); break;
+      case T::kCoordinate: case T::kCoordinateRate:
+        applies(n, what, general, {"name", "type", "coordinate"});
+        s.target = name(n, "coordinate");
+        break;
+      case T::kForceLength: case T::kForceValue:
+        applies(n, what, general, {"name", "type", "force"});
+        s.target = name(n, "force");
+        break;
+      case T::kExpression:
+        applies(n, what, general, {"name", "type", "expression"});
+        s.expression = name(n, "expression");
+        break;
+      default:  // whole-system sensors
+        applies(n, what, general, {"name", "type"});
+        break;
     }
     m.sensors.push_back(s);
   }
@@ -415,41 +653,72 @@ struct Loader {
   AnalysisStep step(const YAML::Node& n) {
     AnalysisStep s;
     s.where = where(n);
-    if (!check_keys(n, "analysis step", {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
-                                         "rtol", "atol", "max_step", "constraint_scale", "formulation",
-                                         "quiet_until", "quiet_sensors"}))
-      return s;
+    static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
+                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence",
+                                   "quiet_until", "quiet_sensors"};
+    if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
     if (type == "assembly") s.type = AnalysisStep::Type::kAssembly;
     else if (type == "equilibrium") s.type = AnalysisStep::Type::kEquilibrium;
     else if (type == "kinematics") s.type = AnalysisStep::Type::kKinematics;
     else if (type == "dynamics") s.type = AnalysisStep::Type::kDynamics;
-    else if (!type.empty()) error(n["type"], "type", "unknown analysis '" + type + "' (assembly, equilibrium, kinematics, dynamics)");
+    else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (assembly, equilibrium, kinematics, dynamics)");
+    const bool integrates = s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics;
+    if (type == "assembly") applies(n, "an assembly step", general, {"type", "hold", "t0"});
+    if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
+    if (integrates)
+      applies(n, "a " + type + " step", general,
+              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence",
+               "quiet_until", "quiet_sensors"});
     s.hold = names(n, "hold");
     s.release = names(n, "release");
     s.unknowns = names(n, "unknowns");
-    s.t0 = number(n, "t0", 0.0);
-    s.t_end = number(n, "t_end", 1.0);
-    s.output_step = number(n, "output_step", 0.01);
-    s.rtol = number(n, "rtol", 1e-6);
-    s.atol = number(n, "atol", 1e-8);
-    s.max_step = number(n, "max_step", 0.0);
-    s.constraint_scale = number(n, "constraint_scale", 0.0);
+    const auto t0 = opt_number(n, "t0"), t_end = opt_number(n, "t_end"), output_step = opt_number(n, "output_step");
+    const auto rtol = opt_number(n, "rtol"), atol = opt_number(n, "atol");
+    const auto max_step = opt_number(n, "max_step"), scale = opt_number(n, "constraint_scale");
+    const auto quiet_until = opt_number(n, "quiet_until");
+    s.t0 = t0.value_or(s.t0);
+    s.t_end = t_end.value_or(s.t_end);
+    s.output_step = output_step.value_or(s.output_step);
+    s.rtol = rtol.value_or(s.rtol);
+    s.atol = atol.value_or(s.atol);
+    s.max_step = max_step.value_or(s.max_step);
+    const auto epcon = opt_number(n, "newton_convergence");
+    s.newton_convergence = epcon.value_or(s.newton_convergence);
+    if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))
+      error(at(n, "newton_convergence"), "newton_convergence",
+            "out of range (0, 1], got " + format_number(s.newton_convergence));
+    s.constraint_scale = scale.value_or(s.constraint_scale);
     s.formulation = text(n, "formulation", "index3");
-    s.quiet_until = number(n, "quiet_until", -1.0);
+    s.quiet_until = quiet_until.value_or(s.quiet_until);
     s.quiet_sensors = names(n, "quiet_sensors");
-    const bool integrates = s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics;
-    if (integrates && !(s.t_end > s.t0)) error(n, "t_end", "the time span is empty (t_end must exceed t0)");
-    if (integrates && !(s.output_step > 0)) error(n, "output_step", "must be positive");
-    if (!(s.rtol >= 1e-14 && s.rtol <= 0.5)) error(has(n, "rtol") ? n["rtol"] : n, "rtol", "out of range [1e-14, 0.5]");
-    if (!(s.atol > 0 && s.atol <= 1.0)) error(has(n, "atol") ? n["atol"] : n, "atol", "out of range (0, 1]");
-    if (s.max_step < 0) error(n["max_step"], "max_step", "must not be negative");
-    if (s.formulation != "index3")
-      error(n["formulation"], "formulation", "unknown formulation '" + s.formulation + "' (index3)");
+    const bool times_ok = (t0 || !has(n, "t0")) && (t_end || !has(n, "t_end"));
+    if (integrates && times_ok && !(s.t_end > s.t0))
+      error(at(n, "t_end"), "t_end", "the time span is empty (t_end " + format_number(s.t_end) +
+                                         " must exceed t0 " + format_number(s.t0) + ")");
+    if (integrates && (output_step || !has(n, "output_step"))) {
+      if (!(s.output_step > 0))
+        error(at(n, "output_step"), "output_step", "must be positive, got " + format_number(s.output_step));
+      else if (times_ok && s.t_end > s.t0 && (s.t_end - s.t0) / s.output_step > kMaxOutputRows)
+        error(at(n, "output_step"), "output_step", "too small: more than 1e8 output rows over [" +
+                                                       format_number(s.t0) + ", " + format_number(s.t_end) + "]");
+    }
+    if (rtol && !(s.rtol >= 1e-14 && s.rtol <= 0.5))
+      error(n["rtol"], "rtol", "out of range [1e-14, 0.5], got " + format_number(s.rtol));
+    if (atol && !(s.atol > 0 && s.atol <= 1.0))
+      error(n["atol"], "atol", "out of range (0, 1], got " + format_number(s.atol));
+    if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
+    if (scale && s.constraint_scale < 0)
+      error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
+    if (has(n, "formulation") && n["formulation"].IsScalar() && s.formulation != "index3")
+      error(n["formulation"], "formulation", "unknown formulation " + quote(s.formulation) + " (index3)");
+    if (integrates && !s.quiet_sensors.empty() && !has(n, "quiet_until"))
+      error(n["quiet_sensors"], "quiet_until", "missing (quiet_sensors are watched until quiet_until)");
     return s;
   }
 
-  // Model sections: a model file, or the scene itself.
+  // Model sections: a model file, or the scene itself (`patch`: entries named like one of the
+  // model replace it).
   void sections(const YAML::Node& root, Model& m, bool patch) {
     if (has(root, "name")) m.name = text(root, "name", m.name);
     if (has(root, "gravity")) m.gravity = vec3(root, "gravity", m.gravity);
@@ -457,16 +726,19 @@ struct Loader {
       if (!has(root, key)) return;
       const YAML::Node list = root[key];
       if (!list.IsSequence()) {
-        error(list, key, "expected a list");
+        error(list, key, "expected a list, got " + describe(list));
         return;
       }
       for (const auto& item : list) fn(item);
     };
-    // In a scene, an entry named like one of the model replaces it.
-    auto replace = [&](auto& vec, size_t before) {
+    auto replace = [&](auto& vec, size_t before, std::set<std::string>& added_here, const char* what) {
       if (!patch || vec.size() == before) return;
       auto added = vec.back();
       vec.pop_back();
+      if (!added.name.empty() && !added_here.insert(added.name).second) {  // keep the first
+        error_at(lines->line(added.where, "name"), "name", std::string(what) + " " + quote(added.name) + " is defined twice in this file");
+        return;
+      }
       for (auto& e : vec)
         if (e.name == added.name) {
           e = added;
@@ -474,61 +746,105 @@ struct Loader {
         }
       vec.push_back(added);
     };
-    each("bodies", [&](const YAML::Node& n) { size_t b = m.bodies.size(); body(n, m); replace(m.bodies, b); });
-    each("joints", [&](const YAML::Node& n) { size_t b = m.joints.size(); joint(n, m); replace(m.joints, b); });
-    each("cuts", [&](const YAML::Node& n) { size_t b = m.cuts.size(); cut(n, m); replace(m.cuts, b); });
-    each("forces", [&](const YAML::Node& n) { size_t b = m.forces.size(); force(n, m); replace(m.forces, b); });
-    each("sensors", [&](const YAML::Node& n) { size_t b = m.sensors.size(); sensor(n, m); replace(m.sensors, b); });
+    std::set<std::string> b_names, j_names, c_names, f_names, s_names;
+    each("bodies", [&](const YAML::Node& n) { size_t b = m.bodies.size(); body(n, m); replace(m.bodies, b, b_names, "body"); });
+    each("joints", [&](const YAML::Node& n) { size_t b = m.joints.size(); joint(n, m); replace(m.joints, b, j_names, "joint"); });
+    each("cuts", [&](const YAML::Node& n) { size_t b = m.cuts.size(); cut(n, m); replace(m.cuts, b, c_names, "cut"); });
+    each("forces", [&](const YAML::Node& n) { size_t b = m.forces.size(); force(n, m); replace(m.forces, b, f_names, "force"); });
+    each("sensors", [&](const YAML::Node& n) { size_t b = m.sensors.size(); sensor(n, m); replace(m.sensors, b, s_names, "sensor"); });
     if (has(root, "coordinates")) {
       const YAML::Node c = root["coordinates"];
-      if (!c.IsMap()) error(c, "coordinates", "expected a mapping name: {initial, mode, drive}");
-      else for (const auto& kv : c) coordinate(kv.first.as<std::string>(), kv.second, m, patch);
+      if (!c.IsMap()) {
+        error(c, "coordinates", "expected a mapping name: {initial, mode, drive}, got " + describe(c));
+      } else {
+        std::set<std::string> seen;
+        for (const auto& kv : c) {
+          const auto cname = key_of(kv.first, "coordinates");
+          if (!cname) continue;
+          if (cname->empty()) error(kv.first, "coordinates", "a coordinate needs a name");
+          else if (!seen.insert(*cname).second) error(kv.first, "coordinates." + *cname, "given twice");
+          else coordinate(*cname, kv.first, kv.second, m, patch);
+        }
+      }
     }
   }
 };
 
-YAML::Node parse(const std::string& text, const std::string& path) {
+// Reads a file of at most kMaxFileBytes; on failure returns nullopt and says why.
+std::optional<std::string> read_text_file(const std::string& path, std::string& why) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) {
+    why = "no such file";
+    return std::nullopt;
+  }
+  if (!std::filesystem::is_regular_file(st)) {
+    why = "not a regular file";
+    return std::nullopt;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    why = "cannot open it";
+    return std::nullopt;
+  }
+  std::string text;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxFileBytes) {
+      why = "larger than " + std::to_string(kMaxFileBytes >> 20) + " MB";
+      return std::nullopt;
+    }
+  }
+  return text;
+}
+
+std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw SceneError({ModelError::format(path, e.mark.line + 1, "", "YAML syntax error: " + e.msg)});
+    issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "YAML syntax error: " + e.msg});
+    return std::nullopt;
   }
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw SceneError({path + ": cannot read the file"});
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-}  // namespace
-
-Scene load_scene_text(const std::string& text, const std::string& path) {
-  Scene scene;
-  scene.file = path;
-  std::vector<std::string> errors;
-  const YAML::Node root = parse(text, path);
-  Loader scene_loader{path, &errors};
-  if (!root.IsMap()) throw SceneError({path + ": the scene must be a YAML mapping"});
+// Loads into `scene`; returns false if the scene could not be read far enough to be validated.
+bool load(const std::string& text, const std::string& path, Scene& scene, std::vector<SceneIssue>& issues,
+          FieldLines& lines) {
+  const auto parsed = parse(text, path, issues);
+  if (!parsed) return false;
+  const YAML::Node root = *parsed;
+  Loader scene_loader{path, &issues, &lines};
+  if (!root.IsMap()) {
+    issues.push_back({path, Loader::line_of(root), "",
+                      root.IsNull() ? "the scene is empty" : "the scene must be a YAML mapping (field: value lines)"});
+    return false;
+  }
+  lines.scene_root = scene_loader.where(root);
   scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
                                           "forces", "sensors", "remove", "analysis", "output"});
-  if (root["model"]) {
-    const std::string model_path =
-        (std::filesystem::path(path).parent_path() / scene_loader.text(root, "model", "")).string();
-    std::string model_text;
-    try {
-      model_text = read_file(model_path);
-    } catch (const SceneError&) {
-      scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "'");
-    }
-    if (!model_text.empty()) {
-      const YAML::Node mroot = parse(model_text, model_path);
-      Loader model_loader{model_path, &errors};
-      model_loader.check_keys(mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                               "forces", "sensors"});
-      model_loader.sections(mroot, scene.model, false);
+  bool complete = true;
+  if (scene_loader.has(root, "model")) {
+    const std::string model = scene_loader.name(root, "model");
+    if (model.empty()) {
+      complete = false;
+    } else {
+      const std::string model_path = (std::filesystem::path(path).parent_path() / model).string();
+      std::string why;
+      const auto model_text = read_text_file(model_path, why);
+      std::optional<YAML::Node> mroot;
+      if (!model_text) scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
+      else mroot = parse(*model_text, model_path, issues);
+      if (!mroot) {
+        complete = false;
+      } else {
+        Loader model_loader{model_path, &issues, &lines};
+        if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
+                                                      "forces", "sensors"}))
+          model_loader.sections(*mroot, scene.model, false);
+        else
+          complete = false;
+      }
     }
   }
   scene_loader.sections(root, scene.model, true);
@@ -545,12 +861,16 @@ Scene load_scene_text(const std::string& text, const std::string& path) {
     drop(scene.model.forces);
     drop(scene.model.sensors);
     drop(scene.model.cuts);
-    if (!found) scene_loader.error(root["remove"], "remove", "nothing named '" + name + "' to remove (forces, sensors, cuts)");
+    if (!found) scene_loader.error(root["remove"], "remove", "nothing named " + quote(name) + " to remove (forces, sensors, cuts)");
   }
-  if (root["analysis"]) {
+  if (scene_loader.has(root, "analysis")) {
     const YAML::Node a = root["analysis"];
-    if (a.IsSequence()) for (const auto& s : a) scene.steps.push_back(scene_loader.step(s));
-    else scene.steps.push_back(scene_loader.step(a));
+    if (a.IsSequence()) {
+      if (a.size() == 0) scene_loader.error(a, "analysis", "no analysis steps (assembly, equilibrium, kinematics or dynamics)");
+      for (const auto& s : a) scene.steps.push_back(scene_loader.step(s));
+    } else {
+      scene.steps.push_back(scene_loader.step(a));
+    }
   } else {
     scene_loader.error(root, "analysis", "missing (assembly, equilibrium, kinematics or dynamics steps)");
   }
@@ -559,10 +879,53 @@ Scene load_scene_text(const std::string& text, const std::string& path) {
     if (s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics) ++integrations;
   if (integrations > 1) scene_loader.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
   scene.columns = scene_loader.names(root, "output");
-  if (!errors.empty()) throw SceneError(errors);
+  return complete;
+}
+
+// Messages sorted by file (in order of first appearance) and line, without repeats.
+std::vector<std::string> messages(const std::vector<SceneIssue>& issues) {
+  std::vector<std::string> files;
+  for (const auto& i : issues)
+    if (std::find(files.begin(), files.end(), i.file) == files.end()) files.push_back(i.file);
+  std::vector<const SceneIssue*> order;
+  for (const auto& i : issues) order.push_back(&i);
+  auto rank = [&](const SceneIssue* i) {
+    const long f = std::find(files.begin(), files.end(), i->file) - files.begin();
+    return std::make_pair(f, i->line > 0 ? i->line : 1 << 30);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](const SceneIssue* a, const SceneIssue* b) { return rank(a) < rank(b); });
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (const SceneIssue* i : order) {
+    std::string t = i->text();
+    if (seen.insert(t).second) out.push_back(std::move(t));
+  }
+  return out;
+}
+
+}  // namespace
+
+Scene load_scene_text(const std::string& text, const std::string& path) {
+  Scene scene;
+  scene.file = path;
+  std::vector<SceneIssue> issues;
+  FieldLines lines;
+  bool complete = false;
+  try {
+    complete = load(text, path, scene, issues, lines);
+  } catch (const YAML::Exception& e) {  // a node shape the loader did not expect
+    issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "cannot read the scene: " + e.msg});
+  }
+  if (complete) validate_scene(scene, lines, issues);
+  if (!issues.empty()) throw SceneError(messages(issues));
   return scene;
 }
 
-Scene load_scene(const std::string& path) { return load_scene_text(read_file(path), path); }
+Scene load_scene(const std::string& path) {
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw SceneError({path + ": cannot read the file (" + why + ")"});
+  return load_scene_text(*text, path);
+}
 
 }  // namespace mbdae

@@ -488,7 +488,9 @@ struct Validator {
     }
     for (const auto& n : unknown) {
       auto later = sensor_index.find(n);
-      if (later != sensor_index.end())
+      if (n == s.name)
+        report(s.where, "expression", who + "the expression uses its own sensor '" + n + "'");
+      else if (later != sensor_index.end())
         report(s.where, "expression", who + "sensor '" + n + "' is listed after this one (an expression may use only sensors listed before it)");
       else
         report(s.where, "expression", who + "unknown name '" + n + "' (names are sensors listed before this one, and pi)" +

@@ -13,7 +13,8 @@ std::map<std::string, UserForceLaw>& registry() {
   return r;
 }
 
-// Built-in example of a user law: linear bushing f = -k d - c d_dot (on point 1 towards 2 is +).
+// Built-in example of a user law: a linear bushing. With d = P2 - P1, the force on point 1 is
+// f = k d + c d_dot, which pulls it towards point 2 (restoring); point 2 gets -f.
 struct BuiltinLaws {
   BuiltinLaws() {
     UserForceLaw bushing;

@@ -587,6 +587,9 @@ System build_system(const Model& model) {
         s.target = sys.force_index(ss.target);
         if (s.target < 0) fail(ss.where, "force", "no force named '" + ss.target + "'");
         break;
+      case SensorSpec::Type::kKineticEnergy:
+      case SensorSpec::Type::kPotentialEnergy:
+        break;  // whole-system quantities: nothing to resolve
       case SensorSpec::Type::kExpression: {
         const int self = static_cast<int>(sys.sensors.size());
         try {
