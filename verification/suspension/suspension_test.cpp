@@ -189,5 +189,26 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
   for (size_t i = 0; i < ev8.size(); ++i) EXPECT_NEAR(ev8[i].get<double>(), ev10[i].get<double>(), 1e-6);
 }
 
+// Damper and tyre removed: kinetic + potential energy (gravity and spring) stays constant.
+TEST(Suspension, FreeOscillationConservesEnergy) {
+  RunOptions o;
+  o.keep_rows = true;
+  o.verbose = false;
+  const RunOutcome r = run_scene(
+      load_scene(std::string(MBDAE_SOURCE_DIR) + "/verification/suspension/scenes/free_oscillation.yaml"), o);
+  ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
+  const int total = column(r, "total"), kinetic = column(r, "kinetic"), z = column(r, "wheel_z");
+  double drift = 0, kmax = 0, zmin = 1e9, zmax = -1e9;
+  for (const auto& row : r.rows) {
+    drift = std::max(drift, std::fabs(row[total] - r.rows.front()[total]));
+    kmax = std::max(kmax, row[kinetic]);
+    zmin = std::min(zmin, row[z]);
+    zmax = std::max(zmax, row[z]);
+  }
+  EXPECT_GT(zmax - zmin, 0.05);  // a real oscillation: several centimetres of wheel travel
+  RecordProperty("relative_energy_drift", std::to_string(drift / kmax));
+  EXPECT_LT(drift / kmax, 1e-7);  // relative to the largest kinetic energy (15 J)
+}
+
 }  // namespace
 }  // namespace mbdae
