@@ -223,6 +223,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         io.nonlinear_convergence = step.newton_convergence;
         js["newton_convergence"] = io.nonlinear_convergence;
         js["rtol"] = io.rtol;
+        js["output_projection"] = step.output_projection;
         js["atol"] = io.atol;
         const double scale = step.constraint_scale > 0 ? step.constraint_scale : automatic_constraint_scale(sys, step);
         js["constraint_scale"] = scale;
@@ -250,7 +251,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         bool printed = false;
         long rows = 0;
         auto output = [&](double t, const double* yy, const double*) {
-          max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, qo, vo, ao));
+          max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, qo, vo, ao, step.output_projection));
           evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];

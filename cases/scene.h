@@ -16,6 +16,7 @@ struct AnalysisStep {
   double rtol = 1e-6, atol = 1e-8, max_step = 0;
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
+  bool output_projection = false;    // project output samples onto the constraints
   std::string formulation = "index3";
   // Report the largest change of these sensors before this time ("nothing moves before").
   double quiet_until = -1;

@@ -654,7 +654,7 @@ struct Loader {
     AnalysisStep s;
     s.where = where(n);
     static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
-                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence",
+                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence", "output_projection",
                                    "quiet_until", "quiet_sensors"};
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
@@ -668,7 +668,7 @@ struct Loader {
     if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
     if (integrates)
       applies(n, "a " + type + " step", general,
-              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence",
+              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "newton_convergence", "output_projection",
                "quiet_until", "quiet_sensors"});
     s.hold = names(n, "hold");
     s.release = names(n, "release");
@@ -683,6 +683,11 @@ struct Loader {
     s.rtol = rtol.value_or(s.rtol);
     s.atol = atol.value_or(s.atol);
     s.max_step = max_step.value_or(s.max_step);
+    if (has(n, "output_projection")) {
+      const std::string v = text(n, "output_projection", "false");
+      if (v == "true") s.output_projection = true;
+      else if (v != "false") error(at(n, "output_projection"), "output_projection", "expected true or false, got " + quote(v));
+    }
     const auto epcon = opt_number(n, "newton_convergence");
     s.newton_convergence = epcon.value_or(s.newton_convergence);
     if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))

@@ -52,10 +52,11 @@ class Index3Dae : public DaeProblem {
 
   // Consistent initial values at rest or from given q, v: solves accelerations and multipliers.
   void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
-  // Projects an interpolated (q, v) onto the constraint manifold (for output), then computes
-  // accelerations. Returns the position violation before projection.
+  // Output state from an interpolated y: optionally projected onto the constraint manifold
+  // (positions and velocities), then the accelerations solved from it. Returns the position
+  // violation of the interpolated y.
   double consistent_output(double t, const double* y, std::vector<double>& q,
-                           std::vector<double>& v, std::vector<double>& a);
+                           std::vector<double>& v, std::vector<double>& a, bool project);
 
   std::vector<char> modes;         // per force: wheel in contact
   double max_position_violation = 0;  // over accepted steps (integrator's own solution)

@@ -35,10 +35,24 @@ cxxflags=(-std=c++17 -O1 -g "${san[@]}" -fsanitize=fuzzer-no-link
   -DMBDAE_FUZZ_SCENE_PATH="\"$here/scene.yaml\"" -Wno-unused-command-line-argument)
 libs=(-lyaml-cpp -lsundials_ida -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
 
-# Sources: everything of core/ and formulation/ (not their tests), the loader and the target.
+# Sources: those of the libraries mbdae_core, mbdae_formulation and mbdae_scene as listed in the
+# top-level CMakeLists.txt (all of core/, formulation/ and the loader if that cannot be read).
+library_sources() {
+  awk -v lib="$1" '
+    $0 ~ "add_library\\(" lib "[ \t]" { on = 1 }
+    on {
+      for (i = 1; i <= NF; ++i) if ($i ~ /\.cpp\)?$/) { f = $i; sub(/\)$/, "", f); print f }
+      if ($0 ~ /\)/) on = 0
+    }' "$root/CMakeLists.txt"
+}
 sources=()
-for f in "$root"/core/*.cpp "$root"/formulation/*.cpp; do sources+=("$f"); done
-sources+=("$root/cases/scene_loader.cpp" "$root/cases/scene_validation.cpp" "$here/scene_loader_fuzz.cpp")
+for lib in mbdae_core mbdae_formulation mbdae_scene; do
+  for f in $(library_sources "$lib"); do sources+=("$root/$f"); done
+done
+if [[ ${#sources[@]} -lt 3 ]]; then
+  sources=("$root"/core/*.cpp "$root"/formulation/*.cpp "$root/cases/scene_loader.cpp" "$root/cases/scene_validation.cpp")
+fi
+sources+=("$here/scene_loader_fuzz.cpp")
 
 mkdir -p "$build/obj" "$build/corpus" "$artifacts"
 flags_file="$build/obj/flags"

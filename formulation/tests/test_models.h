@@ -53,4 +53,101 @@ inline Model pendulum(double mass, double d, double ixx, double theta0) {
   return m;
 }
 
+// A model exercising every constraint and force type: chains R1, R1 R3, R1 R2 R3, T3, T1 R3,
+// R3 T1, weld; cuts of every type; spring-damper, point force, wheel contact, user law.
+// (The same model as in jacobian_fd_test.cpp, which may use this one instead of its copy.)
+inline Model all_types_model() {
+  Model m;
+  m.name = "all_types";
+  m.bodies.push_back(make_body("a", 2.0, Vec3(0.1, 0.2, -0.3), Vec3(0.3, 0.4, 0.5), Vec3(0.01, 0.02, 0.03)));
+  m.bodies.push_back(make_body("b", 1.5, Vec3(0.0, 0.4, 0.1), Vec3(0.2, 0.1, 0.25)));
+  m.bodies.push_back(make_body("c", 1.0, Vec3(0.2, 0.0, 0.0), Vec3(0.1, 0.1, 0.1)));
+  m.bodies.push_back(make_body("d", 3.0, Vec3(0.0, 0.0, 0.1), Vec3(0.2, 0.3, 0.2)));
+  m.bodies.push_back(make_body("e", 0.5, Vec3(0.1, 0.1, 0.1), Vec3(0.05, 0.04, 0.03)));
+  m.bodies.push_back(make_body("f", 0.7, Vec3(0.0, 0.2, 0.0), Vec3(0.05, 0.06, 0.07)));
+  m.bodies.push_back(make_body("g", 0.9, Vec3(0.0, 0.0, 0.0), Vec3(0.05, 0.06, 0.07)));
+  m.bodies[0].points["p"] = Vec3(0.3, -0.1, 0.2);
+  m.joints.push_back(make_joint("ja", kGround, "a", Vec3(0.1, 0, 1), "R1 ", {"qa"}));
+  m.joints.push_back(make_joint("jb", "a", "b", Vec3(0.2, 0.1, -0.4), "R1 R3 ", {"qb1", "qb2"}));
+  m.joints.push_back(make_joint("jc", "b", "c", Vec3(0, 0.5, 0), "R1 R2 R3 ", {"qc1", "qc2", "qc3"}));
+  m.joints.push_back(make_joint("jd", kGround, "d", Vec3(1, 1, 0), "T3 ", {"qd"}));
+  m.joints.push_back(make_joint("je", "d", "e", Vec3(0.1, 0.2, 0.3), "T1 R3 ", {"qe1", "qe2"}));
+  m.joints.push_back(make_joint("jf", "d", "f", Vec3(-0.1, 0.2, 0.3), "R3 T1 ", {"qf1", "qf2"}));
+  m.joints.push_back(make_joint("jg", "f", "g", Vec3(0.0, 0.1, 0.0), "R2 ", {"qg"}));
+  add_coordinate(m, "qa", 0.3);
+  add_coordinate(m, "qb1", -0.2, CoordinateSpec::Mode::kLocked);
+  add_coordinate(m, "qb2", 0.4);
+  add_coordinate(m, "qc1", 0.1);
+  add_coordinate(m, "qc2", 0.2, CoordinateSpec::Mode::kLocked);
+  add_coordinate(m, "qc3", -0.3);
+  add_coordinate(m, "qd", 0.5);
+  add_coordinate(m, "qe1", 0.05);
+  add_coordinate(m, "qe2", 0.3);
+  add_coordinate(m, "qf1", -0.4);
+  add_coordinate(m, "qf2", 0.07, CoordinateSpec::Mode::kDriven);
+  m.coordinates["qf2"].drive.kind = TimeFunction::Kind::kSine;
+  m.coordinates["qf2"].drive.a = 0.1;
+  m.coordinates["qf2"].drive.b = 2.0;
+  add_coordinate(m, "qg", 0.2, CoordinateSpec::Mode::kDriven);
+  m.coordinates["qg"].drive = TimeFunction::constant(0.2);
+  auto cut = [&](CutSpec::Type t, const std::string& b1, const std::string& b2) {
+    CutSpec c;
+    c.name = "cut" + std::to_string(m.cuts.size());
+    c.type = t;
+    c.body1 = b1;
+    c.body2 = b2;
+    c.axis1 = Vec3(0.3, 0.5, 0.8);
+    c.axis2 = Vec3(-0.2, 0.9, 0.1);
+    c.distance = 0.7;
+    m.cuts.push_back(c);
+  };
+  cut(CutSpec::Type::kBall, "c", "e");
+  cut(CutSpec::Type::kRevolute, "c", "g");
+  cut(CutSpec::Type::kUniversal, "a", "e");
+  cut(CutSpec::Type::kPrismatic, "b", "g");
+  cut(CutSpec::Type::kWeld, kGround, "g");
+  cut(CutSpec::Type::kDistance, "a", "d");
+  ForceSpec s;
+  s.name = "spring";
+  s.type = ForceSpec::Type::kSpringDamper;
+  s.body1 = "a";
+  s.point1 = "p";
+  s.body2 = "c";
+  s.stiffness = 100;
+  s.damping = 3;
+  s.free_length = 0.2;
+  m.forces.push_back(s);
+  ForceSpec p;
+  p.name = "push";
+  p.type = ForceSpec::Type::kPointForce;
+  p.body1 = "b";
+  p.fx = TimeFunction::constant(1.0);
+  p.fz = TimeFunction::constant(-2.0);
+  m.forces.push_back(p);
+  ForceSpec w;
+  w.name = "tyre";
+  w.type = ForceSpec::Type::kWheelContact;
+  w.body1 = "g";
+  w.stiffness = 1000;
+  w.radius = 0.3;
+  w.axis = Vec3(0, 1, 0);
+  w.ground = TimeFunction::constant(0.9);
+  m.forces.push_back(w);
+  ForceSpec u;
+  u.name = "bushing";
+  u.type = ForceSpec::Type::kUser;
+  u.body1 = "e";
+  u.body2 = kGround;
+  u.law = "linear_bushing";
+  u.parameters = {{"stiffness", 50.0}, {"damping", 2.0}};
+  m.forces.push_back(u);
+  ForceSpec s2 = s;
+  s2.name = "spring_ground";
+  s2.body1 = kGround;
+  s2.point1 = "";
+  s2.body2 = "d";
+  m.forces.push_back(s2);
+  return m;
+}
+
 }  // namespace mbdae::testing

@@ -1,0 +1,150 @@
+#include "formulation/constraint_rates.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "formulation/constraints.h"
+
+namespace mbdae {
+namespace {
+
+// Global index of local coordinate l of a constraint between bodies bi, bj (or -1).
+inline int global_index(int bi, int bj, int l) {
+  const int b = l < 7 ? bi : bj;
+  return b < 0 ? -1 : 7 * b + (l % 7);
+}
+
+// Constraint types whose Hessian has position (r) entries (as in mechanics.cpp): for the
+// others, the rows of H_i w, and of d(v^T H_i v)/dq, vanish in the r columns.
+inline bool hessian_touches_r(const Constraint& c) {
+  return c.type == Constraint::Type::kDot2 || c.type == Constraint::Type::kDistance ||
+         (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
+}
+
+// Whether local column l of a constraint's Hessian-vector rows is in the pattern.
+inline bool in_pattern(const Constraint& c, int l) {
+  return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || hessian_touches_r(c));
+}
+
+// Hessians of a constraint's rows, one per row.
+void row_hessians(const Constraint& c, const LocalState& s, Mat14* h) {
+  for (int r = 0; r < c.rows(); ++r) {
+    double w[3] = {0, 0, 0};
+    w[r] = 1.0;
+    h[r].setZero();
+    constraint_hessian(c, s, w, h[r]);
+  }
+}
+
+Vec14 to_vec(const LocalState& s) {
+  Vec14 x;
+  x << s.ri, s.pi, s.rj, s.pj;
+  return x;
+}
+LocalState to_state(const Vec14& x) {
+  LocalState s;
+  s.ri = x.head<3>();
+  s.pi = x.segment<4>(3);
+  s.rj = x.segment<3>(7);
+  s.pj = x.tail<4>();
+  return s;
+}
+
+}  // namespace
+
+void constraint_time_rates(const System& sys, const std::vector<int>& off, double t,
+                           double* phi_t) {
+  double pt[3], ptt[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_time_derivatives(c, t, pt, ptt);
+    for (int r = 0; r < c.rows(); ++r) phi_t[off[k] + r] = pt[r];
+  }
+}
+
+void velocity_constraint_values(const System& sys, const std::vector<int>& off, const double* q,
+                                const double* v, double t, double* out) {
+  Row14 rows[3];
+  double pt[3], ptt[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
+    constraint_time_derivatives(c, t, pt, ptt);
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[r].dot(vl) + pt[r];
+  }
+}
+
+void stabilized_acceleration_constraints(const System& sys, const std::vector<int>& off,
+                                         const double* q, const double* v, const double* a,
+                                         double t, double alpha, double beta, double* out) {
+  Row14 rows[3];
+  Mat14 h[3];
+  double phi[3], pt[3], ptt[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const LocalState s = gather(q, c.bi, c.bj);
+    const Vec14 vl = gather_local(v, c.bi, c.bj), al = gather_local(a, c.bi, c.bj);
+    constraint_value(c, s, t, phi);
+    constraint_jacobian(c, s, rows);
+    constraint_time_derivatives(c, t, pt, ptt);
+    row_hessians(c, s, h);
+    for (int r = 0; r < c.rows(); ++r) {
+      const double gamma = -vl.dot(h[r] * vl) - ptt[r];
+      out[off[k] + r] = rows[r].dot(al) - gamma + 2.0 * alpha * (rows[r].dot(vl) + pt[r]) +
+                        beta * beta * phi[r];
+    }
+  }
+}
+
+void assemble_hessian_vector_rows(const System& sys, const std::vector<int>& off, const double* q,
+                                  const double* w1, double s1, const double* w2, double s2,
+                                  int row0, int col0, SparseAssembler& a) {
+  Mat14 h[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    row_hessians(c, gather(q, c.bi, c.bj), h);
+    const Vec14 x1 = gather_local(w1, c.bi, c.bj);
+    const Vec14 x2 = w2 ? gather_local(w2, c.bi, c.bj) : Vec14::Zero();
+    for (int r = 0; r < c.rows(); ++r) {
+      // H symmetric: row r of d(Phi_q w)/dq is w^T H_r = (H_r w)^T.
+      const Vec14 hw = s1 * (h[r] * x1) + (w2 ? s2 * (h[r] * x2) : Vec14::Zero());
+      for (int l = 0; l < 14; ++l)
+        if (in_pattern(c, l)) a.add(row0 + off[k] + r, col0 + global_index(c.bi, c.bj, l), hw[l]);
+    }
+  }
+}
+
+void assemble_gamma_position_derivative_fd(const System& sys, const std::vector<int>& off,
+                                           const double* q, const double* v, double scale,
+                                           int row0, int col0, SparseAssembler& a) {
+  Mat14 hp[3], hm[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    // Hessians of norm and point rows are constant (A(p) s is quadratic in p): no third derivatives.
+    const bool constant_hessian =
+        c.type == Constraint::Type::kNorm || c.type == Constraint::Type::kPoint;
+    const LocalState s = gather(q, c.bi, c.bj);
+    const Vec14 x = to_vec(s), vl = gather_local(v, c.bi, c.bj);
+    double d[3][14] = {};
+    if (!constant_hessian && !a.recording()) {
+      for (int l = 0; l < 14; ++l) {
+        if (!in_pattern(c, l)) continue;
+        const double eps = 1e-6 * std::max(1.0, std::fabs(x[l]));
+        Vec14 xp = x, xm = x;
+        xp[l] += eps;
+        xm[l] -= eps;
+        row_hessians(c, to_state(xp), hp);
+        row_hessians(c, to_state(xm), hm);
+        for (int r = 0; r < c.rows(); ++r)
+          d[r][l] = (vl.dot(hp[r] * vl) - vl.dot(hm[r] * vl)) / (2.0 * eps);
+      }
+    }
+    for (int r = 0; r < c.rows(); ++r)
+      for (int l = 0; l < 14; ++l)
+        if (in_pattern(c, l))
+          a.add(row0 + off[k] + r, col0 + global_index(c.bi, c.bj, l), scale * d[r][l]);
+  }
+}
+
+}  // namespace mbdae

@@ -1,0 +1,46 @@
+// Velocity- and acceleration-level constraint quantities and their derivatives, for the
+// formulations that differentiate the constraints (index-2 GGL, index-1 with Baumgarte).
+//
+// With Phi(q, t) the stacked constraint rows, H_i = d2Phi_i/dq2 (symmetric) and Phi_t a function
+// of t alone (drivers f(t); Phi_qt = 0 for every constraint type):
+//   velocity level      Phi_q v + Phi_t                       d/dq: row i = (H_i v)^T
+//   acceleration level  Phi_q a - gamma,  gamma = -v^T H v - Phi_tt
+//                                                              d/dq of Phi_q a: row i = (H_i a)^T
+//                                                              d(gamma_i)/dv = -2 (H_i v)^T
+// d(gamma_i)/dq = -d(v^T H_i(q) v)/dq needs third derivatives of the constraints, which the
+// constraint library does not provide; it is available here only by central differences of the
+// (exact) local Hessians.
+#pragma once
+
+#include <vector>
+
+#include "core/sparse_assembler.h"
+#include "formulation/system.h"
+
+namespace mbdae {
+
+// Phi_t of every row (explicit time derivative; non-zero for driven coordinates only).
+void constraint_time_rates(const System& sys, const std::vector<int>& offsets, double t,
+                           double* phi_t);
+// Phi_q v + Phi_t (the velocity-level constraints).
+void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,
+                                const double* q, const double* v, double t, double* out);
+// Baumgarte-stabilized acceleration-level constraints, in one pass over the constraints:
+//   out = Phi_q a - gamma(q, v, t) + 2 alpha (Phi_q v + Phi_t) + beta^2 Phi(q, t).
+void stabilized_acceleration_constraints(const System& sys, const std::vector<int>& offsets,
+                                         const double* q, const double* v, const double* a,
+                                         double t, double alpha, double beta, double* out);
+
+// --- Sparse assembly (the same add() sequence whatever the values) -------------------------
+// Row i of  s1 (H_i w1)^T + s2 (H_i w2)^T  at (row0 + i, col0 + global column); w2 may be null
+// (then s2 is ignored). This is s1 d(Phi_q w1)/dq + s2 d(Phi_q w2)/dq for w1, w2 held fixed.
+void assemble_hessian_vector_rows(const System& sys, const std::vector<int>& offsets,
+                                  const double* q, const double* w1, double s1, const double* w2,
+                                  double s2, int row0, int col0, SparseAssembler& a);
+// scale * d(v^T H_i(q) v)/dq (= -scale * d(gamma_i)/dq) by central differences of the local
+// Hessians (step 1e-6 |q|-relative); the pattern is that of assemble_hessian_vector_rows.
+void assemble_gamma_position_derivative_fd(const System& sys, const std::vector<int>& offsets,
+                                           const double* q, const double* v, double scale,
+                                           int row0, int col0, SparseAssembler& a);
+
+}  // namespace mbdae

@@ -1,0 +1,94 @@
+#include "formulation/index1_dae.h"
+
+#include <cmath>
+
+#include "formulation/constraint_rates.h"
+#include "formulation/mechanics.h"
+
+namespace mbdae {
+
+Index1Dae::Index1Dae(const System& sys, double constraint_scale, BaumgarteParameters baumgarte,
+                     bool exact_gamma_q)
+    : MultibodyDae(sys), scale_(constraint_scale), bg_(baumgarte), exact_gamma_q_(exact_gamma_q) {
+  work_.resize(size());
+  // Record the Jacobian pattern once.
+  std::vector<double> y(size(), 0.0), yp(size(), 0.0);
+  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
+  asm_.begin_pattern(size(), size());
+  assemble(0.0, 1.0, y.data(), yp.data());
+  asm_.finalize();
+}
+
+int Index1Dae::residual(double t_in, const double* y, const double* yp, double* r) {
+  const double t = input_time(t_in);
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
+  double* f2 = r + nq_;
+  mass_times(sys_, q, yp + nq_, f2);
+  generalized_forces(sys_, modes, q, v, t, work_.data());
+  for (int i = 0; i < nq_; ++i) f2[i] -= work_[i];
+  add_constraint_forces(sys_, offsets_, q, lambda, f2);
+  double* f3 = r + 2 * nq_;
+  stabilized_acceleration_constraints(sys_, offsets_, q, v, yp + nq_, t, bg_.alpha, bg_.beta, f3);
+  for (int i = 0; i < nc_; ++i) f3[i] *= scale_;
+  for (int i = 0; i < size(); ++i)
+    if (!std::isfinite(r[i])) return 1;  // recoverable: IDA retries with a smaller step
+  return 0;
+}
+
+void Index1Dae::assemble(double t, double cj, const double* y, const double* yp) {
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  const double* acc = yp + nq_;
+  const int rq = 0, rv = nq_, ra = 2 * nq_;  // row blocks F1, F2, F3
+  const int cq = 0, cv = nq_, cl = 2 * nq_;  // column blocks q, v, lambda
+  for (int i = 0; i < nq_; ++i) {
+    asm_.add(rq + i, cq + i, cj);
+    asm_.add(rq + i, cv + i, -1.0);
+  }
+  assemble_mass(sys_, q, cj, rv, cv, asm_);
+  assemble_inertia_derivatives(sys_, q, v, acc, rv, cq, cv, asm_);
+  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, asm_);
+  assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, asm_);
+  // F3, q columns: s [beta^2 Phi_q + (H_k v')^T + 2 alpha (H_k v)^T (+ d(v^T H_k v)/dq)],
+  // with Phi_q^T into F2's lambda columns.
+  const double a = bg_.alpha, b2 = bg_.beta * bg_.beta;
+  assemble_constraint_jacobian(sys_, offsets_, q, scale_ * b2, ra, cq, rv, cl, asm_);
+  assemble_hessian_vector_rows(sys_, offsets_, q, acc, scale_, v, 2.0 * a * scale_, ra, cq, asm_);
+  if (exact_gamma_q_)
+    assemble_gamma_position_derivative_fd(sys_, offsets_, q, v, scale_, ra, cq, asm_);
+  // F3, v columns: s [(cj + 2 alpha) Phi_q + 2 (H_k v)^T].
+  assemble_constraint_jacobian(sys_, offsets_, q, scale_ * (cj + 2.0 * a), ra, cv, -1, -1, asm_);
+  assemble_hessian_vector_rows(sys_, offsets_, q, v, 2.0 * scale_, nullptr, 0.0, ra, cv, asm_);
+}
+
+int Index1Dae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
+  const double t = input_time(t_in);
+  asm_.begin_values(values);
+  assemble(t, cj, y, yp);
+  return 0;
+}
+
+void Index1Dae::error_test_mask(double* id) const {
+  for (int i = 0; i < size(); ++i) id[i] = i < 2 * nq_ ? 1.0 : 0.0;
+}
+
+void Index1Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
+  const double noise = position_noise(y);
+  const double al = mass_scale_ * (atol + noise) / h;
+  for (int i = 0; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
+  for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
+}
+
+void Index1Dae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
+  double* q = y.data();
+  double* v = y.data() + nq_;
+  std::fill(yp.begin(), yp.end(), 0.0);
+  consistent_state(t, q, v, yp.data() + nq_, y.data() + 2 * nq_);
+  std::copy(v, v + nq_, yp.begin());
+}
+
+}  // namespace mbdae

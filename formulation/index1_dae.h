@@ -1,0 +1,76 @@
+// Index-1 (acceleration-level) formulation of a multibody system in absolute coordinates,
+// with Baumgarte stabilization, for IDA:
+//   y = [q, v, lambda],  y' = [q', v', -] (lambda' unused)
+//   F1 = q' - v                                                       = 0
+//   F2 = M(q) v' + Phi_q^T lambda - Q(q, v, t)                        = 0
+//   F3 = s [Phi_q v' - gamma + 2 alpha (Phi_q v + Phi_t) + beta^2 Phi] = 0
+// gamma = -v^T (d2Phi/dq2) v - Phi_tt, so F3 is Phi'' + 2 alpha Phi' + beta^2 Phi = 0 along
+// the solution: the constraints and their rates are not enforced, only their second derivative,
+// and a violation (initial error, each step's local error) decays like exp(-alpha t) (critically
+// damped when alpha = beta) instead of growing linearly (velocity drift) and quadratically
+// (position drift) as it does with alpha = beta = 0.
+//
+// Baumgarte rather than projection after steps: the stabilization lives inside the residual, so
+// IDA's step history, interpolation and error estimates stay those of one smooth DAE (a
+// projection after each step would change the solution behind IDA's back and invalidate its
+// history). The exact solution does not depend on alpha and beta.
+//
+// alpha, beta [1/s] (defaults 20, 20): the drift is about (local error per unit time)/beta^2, and
+// the stabilization adds eigenvalues -alpha +- sqrt(alpha^2 - beta^2) to the constraint
+// directions. With an implicit integrator these do not limit the step (BDF is stable for them),
+// but they must stay below 1/h_typical or the constraint rows dominate the Newton matrix the
+// way index-3 rows do. 20/s damps a violation in ~0.25 s while staying well below 1/h.
+//
+// Error test: q and v (both differential at index 1); lambda is algebraic and left out.
+//
+// The Jacobian dF/dy + cj dF/dy' is exact except for one block: d(gamma)/dq = -d(v^T H_k(q) v)/dq
+// needs third derivatives of the constraints, which are not available. By default
+// (exact_gamma_q = false) it is left out of the Newton matrix: this changes the Newton
+// iteration matrix only, never the residual (so not the solution), and is small next to the
+// cj^2 Phi_q the F3 rows carry effectively (relative size ~ h^2 |v|^2 |d3Phi| / |Phi_q|).
+// The test formulations_test measures its size and the Newton convergence without it. With
+// exact_gamma_q = true it is computed by central differences of the local Hessians.
+// All other blocks are exact: F3 in q columns: s [(H_k v')^T + 2 alpha (H_k v)^T + beta^2 Phi_q],
+// in v columns: s [2 (H_k v)^T + (cj + 2 alpha) Phi_q].
+#pragma once
+
+#include "core/sparse_assembler.h"
+#include "formulation/multibody_dae.h"
+
+namespace mbdae {
+
+struct BaumgarteParameters {
+  double alpha = 20.0;  // [1/s] velocity feedback: 2 alpha (Phi_q v + Phi_t)
+  double beta = 20.0;   // [1/s] position feedback: beta^2 Phi
+};
+
+class Index1Dae : public MultibodyDae {
+ public:
+  explicit Index1Dae(const System& sys, double constraint_scale = 1.0,
+                     BaumgarteParameters baumgarte = {}, bool exact_gamma_q = false);
+
+  int size() const override { return 2 * nq_ + nc_; }
+  const CscPattern& jacobian_pattern() override { return asm_.pattern(); }
+  int residual(double t, const double* y, const double* yp, double* r) override;
+  int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
+  void error_test_mask(double* id) const override;
+  // Positions rtol|q| + atol, velocities rtol|v| + atol; the index-1 multipliers follow the
+  // accelerations, whose error is that of v over h: rtol|lambda| + m_ref (atol + noise)/h.
+  void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
+
+  // Positions and velocities projected onto the constraints, v' and lambda from the
+  // accelerations; y' = [v, v', 0].
+  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) override;
+
+  const BaumgarteParameters& baumgarte() const { return bg_; }
+
+ private:
+  void assemble(double t, double cj, const double* y, const double* yp);
+  double scale_;
+  BaumgarteParameters bg_;
+  bool exact_gamma_q_;
+  SparseAssembler asm_;
+  std::vector<double> work_;
+};
+
+}  // namespace mbdae

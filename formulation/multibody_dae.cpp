@@ -1,0 +1,129 @@
+#include "formulation/multibody_dae.h"
+
+#include <algorithm>
+
+#include "core/errors.h"
+#include "formulation/constraint_rates.h"
+#include "formulation/mechanics.h"
+
+namespace mbdae {
+
+MultibodyDae::MultibodyDae(const System& sys)
+    : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()), aug_(sys) {
+  modes = initial_modes(sys, sys.q0.data(), 0.0);
+  for (const auto& b : sys.bodies) mass_scale_ = std::fmax(mass_scale_, b.mass);
+  for (size_t k = 0; k < sys.forces.size(); ++k)
+    if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
+  stat_work_.resize(std::max(nq_, nc_));
+  out_phi_.resize(nc_);
+}
+
+std::string MultibodyDae::constraint_label(int row) const {
+  for (size_t c = 0; c < sys_.constraints.size(); ++c)
+    if (row < offsets_[c + 1]) return sys_.constraints[c].label;
+  return "row " + std::to_string(row);
+}
+
+std::string MultibodyDae::component_name(int i) const {
+  static const char* names[7] = {"x", "y", "z", "e0", "e1", "e2", "e3"};
+  if (i < 2 * nq_) {
+    const int k = i % nq_;
+    return std::string(i < nq_ ? "" : "velocity of ") + sys_.bodies[k / 7].name + "." + names[k % 7];
+  }
+  if (i < 2 * nq_ + nc_) return "multiplier of " + constraint_label(i - 2 * nq_);
+  return "y[" + std::to_string(i) + "]";
+}
+
+double MultibodyDae::position_noise(const double* y) const {
+  double qmax = 1.0;
+  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
+  return 1e3 * 2.22e-16 * qmax;
+}
+
+void MultibodyDae::switches(double t_in, const double* y, double* g) {
+  const double t = input_time(t_in);
+  for (size_t k = 0; k < switch_forces_.size(); ++k) {
+    const Force& f = sys_.forces[switch_forces_[k]];
+    g[k] = force_switch_value(f, gather(y, f.bi, f.bj), t);
+  }
+}
+
+bool MultibodyDae::changes_mode(double, const double*, const int* roots) {
+  for (size_t k = 0; k < switch_forces_.size(); ++k)
+    if (roots[k] != 0 && modes[switch_forces_[k]] != (roots[k] > 0)) return true;
+  return false;
+}
+
+void MultibodyDae::restart(double t, double* y, double* yp, const int* roots) {
+  for (size_t k = 0; k < switch_forces_.size(); ++k) {
+    const int f = switch_forces_[k];
+    if (roots) {
+      if (roots[k] != 0) modes[f] = roots[k] > 0;
+    } else {
+      const Force& force = sys_.forces[f];
+      modes[f] = force_switch_value(force, gather(y, force.bi, force.bj), t) > 0;
+    }
+  }
+  std::vector<double> yy(y, y + size()), yyp(yp, yp + size());
+  consistent_initial_values(t, yy, yyp);
+  std::copy(yy.begin(), yy.end(), y);
+  std::copy(yyp.begin(), yyp.end(), yp);
+}
+
+double MultibodyDae::initial_step(double, const double* y, const double* yp, double rtol, double atol) {
+  // Weighted RMS norm of q'' = v' over the positions.
+  double sum = 0;
+  for (int i = 0; i < nq_; ++i) {
+    const double w = 1.0 / (rtol * std::fabs(y[i]) + atol);
+    sum += (yp[nq_ + i] * w) * (yp[nq_ + i] * w);
+  }
+  const double norm = std::sqrt(sum / nq_);
+  return norm > 0 ? 0.5 * std::sqrt(2.0 / norm) : 0.0;
+}
+
+void MultibodyDae::after_step(double t_in, const double* y) {
+  const double t = input_time(t_in);
+  constraint_values(sys_, offsets_, y, t, stat_work_.data());
+  max_position_violation = std::fmax(max_position_violation, max_abs(stat_work_.data(), nc_));
+  velocity_constraint_values(sys_, offsets_, y, y + nq_, t, stat_work_.data());
+  max_velocity_violation = std::fmax(max_velocity_violation, max_abs(stat_work_.data(), nc_));
+  for (int b = 0; b < sys_.num_bodies(); ++b) {
+    const double n = Eigen::Map<const Vec4>(y + 7 * b + 3).norm();
+    max_norm_drift = std::fmax(max_norm_drift, std::fabs(n - 1.0));
+  }
+}
+
+void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, double* lambda) {
+  const PositionSolveResult pr = aug_.positions(q, t, 1e-12);
+  if (!pr.converged)
+    throw SolveError("inconsistent_initial_state",
+                     "initial positions violate the constraints (max " + std::to_string(pr.residual) +
+                         "): " + pr.worst);
+  if (!aug_.velocities(q, t, v)) throw SolveError("singular", "velocity projection is singular");
+  if (!aug_.accelerations(modes, q, v, t, a, lambda))
+    throw SolveError("singular",
+                     "the augmented mass matrix is singular at t = " + std::to_string(t) +
+                         " (redundant constraints or an unconstrained massless body)");
+}
+
+double MultibodyDae::consistent_output(double t_in, const double* y, std::vector<double>& q,
+                                       std::vector<double>& v, std::vector<double>& a) {
+  const double t = input_time(t_in);
+  q.assign(y, y + nq_);
+  v.assign(y + nq_, y + 2 * nq_);
+  a.resize(nq_);
+  // An interpolated sample violates the constraints by about the local error: project it back
+  // (positions, then velocities), skipping what already holds to rounding, then solve for the
+  // accelerations of that consistent state.
+  constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
+  const double violation = max_abs(out_phi_.data(), nc_);
+  if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
+  velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
+  double vmax = 1.0;
+  for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
+  if (max_abs(out_phi_.data(), nc_) > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
+  aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+  return violation;
+}
+
+}  // namespace mbdae

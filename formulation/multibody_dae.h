@@ -1,0 +1,83 @@
+// What every multibody formulation shares, whatever its unknowns beyond y = [q, v, ...]:
+// modes of switching forces (wheel contact) and their events, restarts at events and
+// breakpoints, inputs evaluated with their left limit at the end of a segment, the initial step,
+// per-step statistics (constraint violation at position and velocity level, Euler-norm drift),
+// consistent initial values of q, v, accelerations and multipliers, and the projected output.
+//
+// A formulation derives from MultibodyDae and provides size(), the residual, the Jacobian, the
+// error-test mask and weights, and consistent_initial_values() (which places q, v, a and lambda
+// from consistent_state() into its own y, y'). The first 2 nq components of y must be q and v.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/dae_problem.h"
+#include "formulation/augmented_solver.h"
+#include "formulation/system.h"
+
+namespace mbdae {
+
+class MultibodyDae : public DaeProblem {
+ public:
+  explicit MultibodyDae(const System& sys);
+
+  // Names: positions, velocities, then "multiplier of <constraint>" for the next nc
+  // components; formulations with more unknowns override this.
+  std::string component_name(int i) const override;
+  int num_switches() const override { return static_cast<int>(switch_forces_.size()); }
+  void switches(double t, const double* y, double* g) override;
+  // New modes (flipped switches after an event; all from signs at a breakpoint), then
+  // consistent_initial_values() at t from the current q and v.
+  void restart(double t, double* y, double* yp, const int* roots_found) override;
+  bool changes_mode(double t, const double* y, const int* roots_found) override;
+  // First backward-Euler step whose local error h^2/2 |q''| is about the tolerance.
+  double initial_step(double t, const double* y, const double* yp, double rtol, double atol) override;
+  std::vector<double> breakpoints() const override { return sys_.breakpoints(); }
+  // Records max |Phi|, max |Phi_q v + Phi_t| and max | |p| - 1 | of the step's solution.
+  void after_step(double t, const double* y) override;
+  void set_segment(double t_start, double t_end) override { segment_end_ = t_end; }
+  // Time at which inputs (drives, ground profiles, forces) are evaluated: t itself, except at
+  // the end of the current segment, where a jump must not be seen yet (left limit).
+  double input_time(double t) const {
+    const double cap = segment_end_ - 1e-13 * (1.0 + std::fabs(segment_end_));
+    return t < cap ? t : cap;
+  }
+
+  // Consistent initial values from the q and v in y (projected onto the constraints).
+  virtual void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) = 0;
+  // Projects an interpolated (q, v) onto the constraint manifold (for output), then computes
+  // accelerations. Returns the position violation before projection.
+  double consistent_output(double t, const double* y, std::vector<double>& q,
+                           std::vector<double>& v, std::vector<double>& a);
+
+  std::vector<char> modes;            // per force: wheel in contact
+  double max_position_violation = 0;  // max |Phi| over accepted steps (integrator's own solution)
+  double max_velocity_violation = 0;  // max |Phi_q v + Phi_t| over accepted steps
+  double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
+  int nq() const { return nq_; }
+  int nc() const { return nc_; }
+  const System& system() const { return sys_; }
+  AugmentedSolver& augmented() { return aug_; }
+
+ protected:
+  // Projects q (positions) and v (velocities) onto the constraints at t and solves the
+  // accelerations a and multipliers lambda with the current modes. Throws SolveError.
+  void consistent_state(double t, double* q, double* v, double* a, double* lambda);
+  // Label of the constraint owning stacked constraint row `row`.
+  std::string constraint_label(int row) const;
+  // Noise floor of the positions: about 1e3 eps max(1, |q|).
+  double position_noise(const double* y) const;
+
+  const System& sys_;
+  std::vector<int> offsets_;
+  int nq_, nc_;
+  double mass_scale_ = 1e-3;  // largest body mass (multipliers are forces: mass-scaled weights)
+  double segment_end_ = 1e300;
+  std::vector<int> switch_forces_;
+  AugmentedSolver aug_;
+  std::vector<double> stat_work_, out_phi_;
+};
+
+}  // namespace mbdae
