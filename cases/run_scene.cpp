@@ -11,6 +11,8 @@
 #include "formulation/analyses.h"
 #include "formulation/index3_dae.h"
 #include "formulation/mechanics.h"
+#include "formulation/augmented_solver.h"
+#include "formulation/redundancy.h"
 #include "formulation/sensors.h"
 
 namespace mbdae {
@@ -107,6 +109,30 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
       if (f.body < 0 && name != kGround) ground.push_back(name);
     summary["merged_into_body"] = merged;
     summary["merged_into_ground"] = ground;
+  }
+  // Redundant constraint equations, found at a configuration that satisfies the constraints
+  // (a regularized projection of the guess), then removed or reported as an error.
+  {
+    std::vector<double> qc = sys.q0;
+    AugmentedSolver projector(sys);
+    projector.positions(qc.data(), 0.0, 1e-12, 100, 1e-10);
+    const bool remove = scene.redundant_constraints != "fail";
+    const RedundancyReport rr = find_redundant_constraints(sys, qc.data(), 0.0, remove);
+    summary["redundant_constraints"] = {{"policy", scene.redundant_constraints},
+                                        {"equations", rr.equations},
+                                        {"rank", rr.rank},
+                                        {"redundant", rr.redundant}};
+    if (!rr.redundant.empty()) {
+      std::string list;
+      for (const auto& r : rr.redundant) list += "\n  " + r;
+      if (!remove)
+        throw ModelError(scene.file, 0, "redundant_constraints",
+                         std::to_string(rr.redundant.size()) + " redundant constraint equations:" + list);
+      if (opt.verbose)
+        std::fprintf(stderr, "mbdae: removed %zu redundant constraint equations:%s\n", rr.redundant.size(),
+                     list.c_str());
+    }
+    summary["constraint_equations"] = sys.num_constraint_rows();
   }
   std::vector<double> q = sys.q0;
   // Output columns.

@@ -29,6 +29,7 @@ struct Scene {
   Model model;
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
+  std::string redundant_constraints = "remove";  // or "fail"
 };
 
 // One message per problem found in the scene (file:line: field 'x': ...).

@@ -427,21 +427,31 @@ struct Loader {
       error(at(n, "coordinates"), "coordinates",
             "expected one coordinate name per elementary joint of the chain (" + std::to_string(chain.size()) +
                 ", got " + std::to_string(coords.size()) + ")");
+    bool chain_ok = true;
     for (size_t k = 0; k < chain.size(); ++k) {
       const std::string& e = chain[k];
       ElementaryJoint ej;
       if (e.size() != 2 || (e[0] != 'R' && e[0] != 'T') || e[1] < '1' || e[1] > '3') {
         error_at(lines->line(j.where, "chain[" + std::to_string(k) + "]"), "chain",
                  "unknown elementary joint " + quote(e) + " (R1 R2 R3 T1 T2 T3)");
-        continue;
+        chain_ok = false;
       }
       ej.rotation = e[0] == 'R';
-      ej.axis = e[1] - '1';
+      ej.axis = e.size() == 2 ? e[1] - '1' : 0;
       ej.coordinate = k < coords.size() ? coords[k] : "";
       if (k < coords.size() && coords[k].empty())
         error_at(lines->line(j.where, "coordinates[" + std::to_string(k) + "]"), "coordinates",
                  "a coordinate name must not be empty");
       j.chain.push_back(ej);
+    }
+    // A chain with an unknown element (already reported) keeps its coordinates on a placeholder
+    // chain R1 R2 R3 T1 T2 T3, so that they are not reported again as belonging to no joint.
+    if (!chain_ok) {
+      if (j.chain.size() > 6) j.chain.resize(6);
+      for (size_t k = 0; k < j.chain.size(); ++k) {
+        j.chain[k].rotation = k < 3;
+        j.chain[k].axis = static_cast<int>(k % 3);
+      }
     }
     m.joints.push_back(j);
   }
@@ -613,6 +623,10 @@ struct Loader {
         for (const auto& kv : types) known.push_back(kv.first);
         error(n["type"], "type", "unknown sensor type " + quote(type) + " (" + join(known) + ")" + did_you_mean(type, known));
       }
+      // Keep the name (as an empty expression, which nothing checks) so that output columns and
+      // expressions naming this sensor are not reported as well; the scene is rejected anyway.
+      s.type = T::kExpression;
+      if (!s.name.empty()) m.sensors.push_back(s);
       return;
     }
     s.type = it->second;
@@ -827,7 +841,8 @@ bool load(const std::string& text, const std::string& path, Scene& scene, std::v
   }
   lines.scene_root = scene_loader.where(root);
   scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                          "forces", "sensors", "remove", "analysis", "output"});
+                                          "forces", "sensors", "remove", "analysis", "output",
+                                          "redundant_constraints"});
   bool complete = true;
   if (scene_loader.has(root, "model")) {
     const std::string model = scene_loader.name(root, "model");
@@ -884,6 +899,12 @@ bool load(const std::string& text, const std::string& path, Scene& scene, std::v
     if (s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics) ++integrations;
   if (integrations > 1) scene_loader.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
   scene.columns = scene_loader.names(root, "output");
+  if (root["redundant_constraints"]) {
+    scene.redundant_constraints = scene_loader.text(root, "redundant_constraints", "remove");
+    if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail")
+      scene_loader.error(root["redundant_constraints"], "redundant_constraints",
+                         "expected remove or fail, got '" + scene.redundant_constraints + "'");
+  }
   return complete;
 }
 

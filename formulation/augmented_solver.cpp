@@ -22,13 +22,15 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   work2_.resize(n);
 }
 
-void AugmentedSolver::assemble(const double* q, bool with_mass) {
-  // The same add() sequence for both: the weight pattern equals the mass pattern.
+void AugmentedSolver::assemble(const double* q, bool with_mass, double regularization) {
+  // The same add() sequence for all: the weight pattern equals the mass pattern, and the
+  // constraint block's diagonal is always in the pattern.
   if (with_mass)
     assemble_mass(sys_, q, 1.0, 0, 0, asm_);
   else
     assemble_weights(sys_, 1.0, 1.0, 0, 0, asm_);
   assemble_constraint_jacobian(sys_, offsets_, q, 1.0, nq_, 0, 0, nq_, asm_);
+  for (int i = 0; i < nc_; ++i) asm_.add(nq_ + i, nq_ + i, -regularization);
 }
 
 bool AugmentedSolver::accelerations(const std::vector<char>& modes, const double* q,
@@ -58,16 +60,18 @@ bool AugmentedSolver::velocities(const double* q, double t, double* v) {
   return true;
 }
 
-PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, int max_iter) {
+PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, int max_iter,
+                                               double regularization) {
   PositionSolveResult res;
   std::vector<double>& phi = work_;
   constraint_values(sys_, offsets_, q, t, phi.data());
   double norm = max_abs(phi.data(), nc_);
   std::vector<double> trial(q, q + nq_);
   for (res.iterations = 0; res.iterations < max_iter && norm > tol; ++res.iterations) {
-    // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi].
+    // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q -eps I] [dq; mu] = [0; -Phi]. With
+    // eps > 0 (Levenberg-Marquardt) the step exists also for redundant constraints.
     asm_.begin_values(values_.data());
-    assemble(q, false);
+    assemble(q, false, regularization);
     if (!klu_.factor(values_.data())) break;
     std::fill(rhs_.begin(), rhs_.begin() + nq_, 0.0);
     for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -phi[i];

@@ -29,13 +29,14 @@ class AugmentedSolver {
   bool accelerations(const std::vector<char>& modes, const double* q, const double* v, double t,
                      double* a, double* lambda);
   bool velocities(const double* q, double t, double* v);
-  PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100);
+  PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100,
+                                double regularization = 0.0);
   const std::vector<int>& offsets() const { return offsets_; }
   int factorizations() const { return klu_.factorizations(); }
   double last_rcond() { return klu_.rcond(); }
 
  private:
-  void assemble(const double* q, bool with_mass);
+  void assemble(const double* q, bool with_mass, double regularization = 0.0);
   const System& sys_;
   std::vector<int> offsets_;
   int nq_, nc_;

@@ -186,9 +186,8 @@ void constraint_value(const Constraint& c, const LocalState& s, double t, double
     case Constraint::Type::kNorm: v[0] = s.pi.squaredNorm() - 1.0; return;
     case Constraint::Type::kPoint: {
       const Vec3 d = world_point(c.bi, s.ri, s.pi, c.si) - world_point(c.bj, s.rj, s.pj, c.sj);
-      v[0] = d[0];
-      v[1] = d[1];
-      v[2] = d[2];
+      for (int k = 0, r = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) v[r++] = d[k];
       return;
     }
     case Constraint::Type::kDot1:
@@ -215,10 +214,20 @@ void constraint_jacobian(const Constraint& c, const LocalState& s, Row14* rows) 
   for (int k = 0; k < c.rows(); ++k) rows[k].setZero();
   switch (c.type) {
     case Constraint::Type::kNorm: rows[0].segment<4>(kPi4) = 2.0 * s.pi.transpose(); return;
-    case Constraint::Type::kPoint:
-      add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, rows);
-      add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, rows);
+    case Constraint::Type::kPoint: {
+      if (c.mask == 7) {
+        add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, rows);
+        add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, rows);
+        return;
+      }
+      Row14 full[3];
+      for (auto& f : full) f.setZero();
+      add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, full);
+      add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, full);
+      for (int k = 0, r = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) rows[r++] = full[k];
       return;
+    }
     case Constraint::Type::kDot1: rows[0] = dot1_jet(c.bi, c.bj, s, c.ai, c.aj).grad; return;
     case Constraint::Type::kDot2:
       rows[0] = dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).grad;
@@ -240,7 +249,9 @@ void constraint_hessian(const Constraint& c, const LocalState& s, const double* 
   switch (c.type) {
     case Constraint::Type::kNorm: h.block<4, 4>(kPi4, kPi4) += 2.0 * w[0] * Mat4::Identity(); return;
     case Constraint::Type::kPoint: {
-      const Vec3 lam(w[0], w[1], w[2]);
+      Vec3 lam = Vec3::Zero();
+      for (int k = 0, r = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) lam[k] = w[r++];
       if (c.bi >= 0) h.block<4, 4>(kPi4, kPi4) += K_matrix(c.si, lam);
       if (c.bj >= 0) h.block<4, 4>(kPj, kPj) -= K_matrix(c.sj, lam);
       return;

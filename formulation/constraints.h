@@ -55,8 +55,9 @@ struct Constraint {
   CoordinateFunction coord;  // kCoordinate
   TimeFunction target;       // kCoordinate: f(t)
   std::string label;         // e.g. "joint rod2: axis x _|_ z"
+  int mask = 7;              // kPoint: active components (bit k = world axis k); rows compacted
 
-  int rows() const { return type == Type::kPoint ? 3 : 1; }
+  int rows() const { return type == Type::kPoint ? __builtin_popcount(mask) : 1; }
 };
 
 // Local coordinates of a constraint's two bodies, gathered from the global vector q.

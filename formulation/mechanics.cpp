@@ -118,7 +118,8 @@ void constraint_rates(const System& sys, const std::vector<int>& off, const doub
       case Constraint::Type::kNorm: g[0] = -2.0 * sv.pi.squaredNorm() - ptt[0]; break;
       case Constraint::Type::kPoint: {
         const Vec3 h = quad(c.bi, sv.pi, c.si) - quad(c.bj, sv.pj, c.sj);
-        for (int r = 0; r < 3; ++r) g[r] = -h[r] - ptt[r];
+        for (int k = 0, r = 0; k < 3; ++k)
+          if (c.mask & (1 << k)) { g[r] = -h[k] - ptt[r]; ++r; }
         break;
       }
       case Constraint::Type::kDot1: {

@@ -8,6 +8,7 @@
 
 #include "cases/run_scene.h"
 #include "cases/scene.h"
+#include "core/errors.h"
 #include "verification/reference/suspension_reference.h"
 
 namespace mbdae {
@@ -187,6 +188,31 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
   const json& ev8 = step_of(r8, "dynamics")["event_times"];
   ASSERT_EQ(ev8.size(), ev10.size());
   for (size_t i = 0; i < ev8.size(); ++i) EXPECT_NEAR(ev8[i].get<double>(), ev10[i].get<double>(), 1e-6);
+}
+
+// The source's "ball cut 5" repeats the tree joint rod 5 - carrier: its three equations are
+// flagged as redundant by name (fail policy), or removed (default) with the same assembly.
+TEST(Suspension, BallCut5IsFlaggedAsRedundant) {
+  const std::string path = std::string(MBDAE_SOURCE_DIR) + "/verification/suspension/scenes/ball_cut_5.yaml";
+  Scene scene = load_scene(path);
+  RunOptions o;
+  o.verbose = false;
+  try {
+    run_scene(scene, o);
+    ADD_FAILURE() << "redundancy not reported";
+  } catch (const ModelError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("3 redundant constraint equations"), std::string::npos) << m;
+    for (const char* c : {"x", "y", "z"})
+      EXPECT_NE(m.find(std::string("cut ball5: coincident points [") + c + "]"), std::string::npos) << m;
+  }
+  scene.redundant_constraints = "remove";
+  const RunOutcome r = run_scene(scene, o);
+  ASSERT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.summary["redundant_constraints"]["redundant"].size(), 3u);
+  const ref::SuspensionData data = ref::spec_data();
+  const ref::WheelOutputs w = ref::wheel_outputs(data, ref::design_pose(data));
+  EXPECT_NEAR(step_of(r, "assembly")["sensors"]["wheel_z"].get<double>(), w.centre.z(), 1e-9);
 }
 
 // Damper and tyre removed: kinetic + potential energy (gravity and spring) stays constant.
