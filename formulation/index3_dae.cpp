@@ -84,7 +84,10 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
   for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
   const double noise = 1e3 * 2.22e-16 * qmax;
   const double av = atol + noise / h, al = mass_scale_ * (atol + noise / (h * h));
-  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
+  // Positions: the user's tolerances, but never below ten roundings of the largest coordinate
+  // (an atol under that asks the Newton iteration for digits that do not exist).
+  const double aq = std::fmax(atol, 10 * 2.22e-16 * qmax);
+  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
