@@ -276,8 +276,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         auto last_print = wall0;
         bool printed = false;
         long rows = 0;
-        auto output = [&](double t, const double* yy, const double*) {
-          max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, qo, vo, ao, step.output_projection));
+        auto output = [&](double t, const double* yy, const double* yyp) {
+          max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, yyp, qo, vo, ao, step.output_projection));
           evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];

@@ -175,13 +175,11 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     while (!stop_requested && sample_index >= 0) {
       const double ts = sample_time(sample_index);
       if (ts > t_reached || (!inclusive && ts == t_reached)) break;
-      if (ts == t_reached) {
-        if (!output(ts, N_VGetArrayPointer(y), N_VGetArrayPointer(yp))) stop_requested = true;
-      } else {
-        IDAGetDky(mem, ts, 0, ys);
-        IDAGetDky(mem, ts, 1, yps);
-        if (!output(ts, N_VGetArrayPointer(ys), N_VGetArrayPointer(yps))) stop_requested = true;
-      }
+      // Always from IDA's interpolant (also at a step's own time: the y' IDA returns at a stop
+      // time is not the derivative of its position interpolant).
+      IDAGetDky(mem, ts, 0, ys);
+      IDAGetDky(mem, ts, 1, yps);
+      if (!output(ts, N_VGetArrayPointer(ys), N_VGetArrayPointer(yps))) stop_requested = true;
       if (ts >= o.t1) { sample_index = -1; break; }
       ++sample_index;
       t_next_sample = sample_time(sample_index);
@@ -195,8 +193,10 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   double t = o.t0;
   size_t next_bp = 0;
   auto next_stop = [&] { return next_bp < bps.size() ? bps[next_bp] : o.t1; };
+  // Only a real breakpoint ends a segment: the end of the run is no jump of the inputs.
+  auto segment_end = [&] { return next_bp < bps.size() ? bps[next_bp] : 1e300; };
   IDASetStopTime(mem, next_stop());
-  problem.set_segment(t, next_stop());
+  problem.set_segment(t, segment_end());
   // The last accepted step (interpolated root states are never kept here).
   double t_prev = t;
   std::vector<double> y_prev(y0), yp_prev(yp0);
@@ -280,7 +280,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     }
     collect(mem, stats);
     while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
-    problem.set_segment(t, next_stop());
+    problem.set_segment(t, segment_end());
     try {
       problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
     } catch (const SolveError& e) {

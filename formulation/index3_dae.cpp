@@ -173,10 +173,15 @@ void Index3Dae::after_step(double t_in, const double* y) {
   }
 }
 
-double Index3Dae::consistent_output(double t_in, const double* y, std::vector<double>& q,
-                                    std::vector<double>& v, std::vector<double>& a, bool project) {
+double Index3Dae::consistent_output(double t_in, const double* y, const double* yp,
+                                    std::vector<double>& q, std::vector<double>& v,
+                                    std::vector<double>& a, bool project) {
   const double t = input_time(t_in);
   q.assign(y, y + nq_);
+  // Velocities: the interpolant of v (through the steps' velocities, one degree higher than the
+  // derivative of the positions' interpolant, and measured more accurate: spring-body energy
+  // 9.6e-9 against 1.6e-8).
+  (void)yp;
   v.assign(y + nq_, y + 2 * nq_);
   a.resize(nq_);
   // An interpolated sample violates the constraints by about the local error. If asked, project

@@ -52,10 +52,10 @@ class Index3Dae : public DaeProblem {
 
   // Consistent initial values at rest or from given q, v: solves accelerations and multipliers.
   void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
-  // Output state from an interpolated y: optionally projected onto the constraint manifold
+  // Output state from an interpolated (y, y'): optionally projected onto the constraint manifold
   // (positions and velocities), then the accelerations solved from it. Returns the position
   // violation of the interpolated y.
-  double consistent_output(double t, const double* y, std::vector<double>& q,
+  double consistent_output(double t, const double* y, const double* yp, std::vector<double>& q,
                            std::vector<double>& v, std::vector<double>& a, bool project);
 
   std::vector<char> modes;         // per force: wheel in contact
