@@ -66,7 +66,8 @@ PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, 
   std::vector<double>& phi = work_;
   constraint_values(sys_, offsets_, q, t, phi.data());
   double norm = max_abs(phi.data(), nc_);
-  std::vector<double> trial(q, q + nq_);
+  std::vector<double>& trial = trial_;
+  trial.assign(q, q + nq_);
   for (res.iterations = 0; res.iterations < max_iter && norm > tol; ++res.iterations) {
     // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q -eps I] [dq; mu] = [0; -Phi]. With
     // eps > 0 (Levenberg-Marquardt) the step exists also for redundant constraints.

@@ -42,7 +42,7 @@ class AugmentedSolver {
   int nq_, nc_;
   SparseAssembler asm_;
   KluSolver klu_;
-  std::vector<double> values_, rhs_, work_, work2_;
+  std::vector<double> values_, rhs_, work_, work2_, trial_;
 };
 
 }  // namespace mbdae

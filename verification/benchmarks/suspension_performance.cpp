@@ -1,0 +1,181 @@
+// Whole-analysis performance of the five-point suspension: CPU time against achieved accuracy,
+// the work counts, the kernels' unit costs and how close each run is to its minimal work
+//   W_min = residual evals x c_res + Jacobian evals x c_jac + KLU factorizations x c_klu
+//           + output samples x c_out,
+// and peak memory of each analysis run as its own process (build/mbdae).
+// Usage: suspension_performance [--quick]   (prints markdown; docs/performance.md holds a run)
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cases/run_scene.h"
+#include "cases/scene.h"
+#include "core/klu_solver.h"
+#include "formulation/analyses.h"
+#include "formulation/index3_dae.h"
+#include "formulation/mechanics.h"
+#include "formulation/sensors.h"
+
+namespace {
+using namespace mbdae;
+using json = nlohmann::ordered_json;
+
+const std::string kDir = std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/";
+
+struct Run {
+  RunOutcome out;
+  double cpu = 0;
+  json stats;
+};
+
+Run run(const std::string& scene, double rtol, double atol, bool keep = true) {
+  RunOptions o;
+  o.keep_rows = keep;
+  o.verbose = false;
+  o.progress = false;
+  o.rtol = rtol;
+  o.atol = atol;
+  Run r;
+  r.out = run_scene(load_scene(kDir + scene), o);
+  r.stats = r.out.summary["steps"].back()["statistics"];
+  r.cpu = r.stats["cpu_seconds"].get<double>();
+  return r;
+}
+
+double max_error(const Run& a, const Run& ref, const std::string& col) {
+  const auto ca = std::find(a.out.columns.begin(), a.out.columns.end(), col) - a.out.columns.begin();
+  const auto cr = std::find(ref.out.columns.begin(), ref.out.columns.end(), col) - ref.out.columns.begin();
+  double m = 0;
+  for (size_t i = 0; i < std::min(a.out.rows.size(), ref.out.rows.size()); ++i)
+    m = std::max(m, std::fabs(a.out.rows[i][ca] - ref.out.rows[i][cr]));
+  return m;
+}
+
+// Peak resident memory (MB) of `mbdae run SCENE` as a child process.
+double peak_memory_mb(const std::string& scene) {
+  const std::string exe = std::string(MBDAE_SOURCE_DIR) + "/build/mbdae";
+  const std::string out = "/tmp/mbdae_perf_mem";
+  pid_t pid = fork();
+  if (pid == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execl(exe.c_str(), exe.c_str(), "run", (kDir + scene).c_str(), "--out", out.c_str(), "--quiet",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  wait4(pid, &status, 0, &ru);
+  return ru.ru_maxrss / 1024.0;
+}
+
+// Unit costs (seconds) of the kernels on a scene's system at its first dynamic state.
+struct Costs {
+  double residual = 0, jacobian = 0, klu = 0, output = 0;
+  int bodies = 0;
+};
+Costs kernel_costs(const std::string& scene_file) {
+  Scene scene = load_scene(kDir + scene_file);
+  RunOptions o;
+  o.verbose = false;
+  Scene statics = scene;
+  statics.steps.pop_back();  // assembly and equilibria only
+  const RunOutcome pre = run_scene(statics, o);
+  System sys = build_system(scene.model);
+  if (pre.summary.contains("spring_free_length"))
+    sys.forces[sys.force_index("suspension")].free_length = pre.summary["spring_free_length"].get<double>();
+  Index3Dae dae(sys, 1.0);
+  std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0), r(dae.size());
+  std::copy(pre.q.begin(), pre.q.end(), y.begin());
+  dae.modes = initial_modes(sys, y.data(), 0.0);
+  dae.consistent_initial_values(0.0, y, yp);
+  std::vector<double> values(dae.jacobian_pattern().nnz()), q, v, a, s(sys.sensors.size());
+  KluSolver klu;
+  klu.analyze(dae.jacobian_pattern());
+  dae.jacobian(0.0, 1e4, y.data(), yp.data(), values.data());
+  klu.factor(values.data());
+  auto time = [](auto&& f) {
+    const int n = 2000;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < n; ++i) f();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n;
+  };
+  Costs c;
+  c.bodies = sys.num_bodies();
+  c.residual = time([&] { dae.residual(0.0, y.data(), yp.data(), r.data()); });
+  c.jacobian = time([&] { dae.jacobian(0.0, 1e4, y.data(), yp.data(), values.data()); });
+  c.klu = time([&] { klu.factor(values.data()); });
+  c.output = time([&] {
+    dae.consistent_output(0.0, y.data(), yp.data(), q, v, a, false);
+    evaluate_sensors(sys, dae.modes, q.data(), v.data(), a.data(), 0.0, s.data());
+  });
+  return c;
+}
+
+struct Analysis {
+  std::string name, scene;
+  double ref_rtol, ref_atol;
+  std::vector<double> ladder;  // rtol values; atol = 1e-6 rtol
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const int reps = quick ? 1 : 3;
+  std::vector<Analysis> analyses = {
+      {"kinematics", "kinematics.yaml", 1e-12, 1e-12, {1e-6, 1e-8, 1e-10}},
+      {"dynamics I", "dynamics_step.yaml", 1e-11, 1e-16, {1e-5, 1e-6, 1e-7, 1e-8}},
+      {"dynamics II", "dynamics_poster.yaml", 1e-10, 1e-16, {1e-5, 1e-6, 1e-7}},
+  };
+  if (quick) analyses.pop_back();
+  std::printf("| analysis | rtol | CPU median (s) | max wheel_z error (m) | steps | residual evals | Jacobians | KLU factorizations | samples | W_min (s) | CPU / W_min |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::string> summary_lines;
+  for (const Analysis& an : analyses) {
+    const Costs c = kernel_costs(an.scene);
+    const Run ref = run(an.scene, an.ref_rtol, an.ref_atol);
+    const Run check = run(an.scene, an.ref_rtol * 10, an.ref_atol * 10);
+    const double ref_err = max_error(check, ref, "wheel_z");
+    double best_cpu = -1, best_tol = 0;
+    for (double tol : an.ladder) {
+      std::vector<double> cpus;
+      Run r;
+      for (int k = 0; k < reps; ++k) {
+        r = run(an.scene, tol, tol * 1e-6);
+        cpus.push_back(r.cpu);
+      }
+      std::sort(cpus.begin(), cpus.end());
+      const double cpu = cpus[cpus.size() / 2];
+      const double err = max_error(r, ref, "wheel_z");
+      const long res = r.stats["residual_evaluations"], jac = r.stats["jacobian_evaluations"];
+      const long fac = r.stats["klu_factorizations"], samples = r.stats["output_rows"];
+      const double wmin = res * c.residual + jac * c.jacobian + fac * c.klu + samples * c.output;
+      std::printf("| %s | %.0e | %.4f | %.2e | %ld | %ld | %ld | %ld | %ld | %.4f | %.2f |\n", an.name.c_str(), tol,
+                  cpu, err, r.stats["steps"].get<long>(), res, jac, fac, samples, wmin, cpu / wmin);
+      if (err <= 1e-6 && best_cpu < 0) {
+        best_cpu = cpu;
+        best_tol = tol;
+      }
+    }
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "| %s | %d | %.2f | %.2f | %.2f | %.2f | %.1f | %.2e | %s | %.1f |", an.name.c_str(), c.bodies,
+                  c.residual * 1e6, c.jacobian * 1e6, c.klu * 1e6, c.output * 1e6, c.residual * 1e9 / c.bodies,
+                  ref_err, best_cpu > 0 ? (std::to_string(best_cpu * 1e3).substr(0, 6) + " ms at rtol " + std::to_string(best_tol).substr(0, 8)).c_str() : "not reached",
+                  peak_memory_mb(an.scene));
+    summary_lines.push_back(line);
+  }
+  std::printf("\n| analysis | bodies | residual (us) | Newton matrix (us) | KLU refactor (us) | output sample (us) | residual ns/body | reference converged to | CPU for wheel_z within 1e-6 m | peak memory (MB) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& l : summary_lines) std::printf("%s\n", l.c_str());
+  return 0;
+}
