@@ -254,6 +254,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         const double scale = step.constraint_scale > 0 ? step.constraint_scale : automatic_constraint_scale(sys, step);
         js["constraint_scale"] = scale;
         Index3Dae dae(sys, scale);
+        dae.track_condition = step.type == AnalysisStep::Type::kKinematics;
         dae.modes = initial_modes(sys, q.data(), step.t0);
         std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
         std::copy(q.begin(), q.end(), y.begin());
@@ -318,6 +319,11 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         stats["max_position_violation_steps"] = dae.max_position_violation;
         stats["max_position_violation_output_before_projection"] = max_output_violation;
         stats["max_euler_norm_drift"] = dae.max_norm_drift;
+        if (dae.track_condition) {
+          // Closeness to a singular configuration along a kinematic run.
+          stats["max_constraint_condition"] = dae.max_condition;
+          stats["max_constraint_condition_time"] = dae.max_condition_time;
+        }
         stats["output_rows"] = out.rows.size() ? static_cast<long>(out.rows.size()) : rows;
         js["statistics"] = stats;
         js["event_times"] = st.event_times;

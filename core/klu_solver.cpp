@@ -1,6 +1,7 @@
 #include "core/klu_solver.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace mbdae {
 
@@ -43,6 +44,12 @@ bool KluSolver::factor(const double* values) {
 bool KluSolver::solve(double* b) {
   if (!numeric_) return false;
   return klu_solve(symbolic_, numeric_, pattern_.rows, 1, b, &common_) != 0;
+}
+
+double KluSolver::condest() {
+  if (!numeric_) return INFINITY;
+  klu_condest(pattern_.colptr.data(), values_.data(), symbolic_, numeric_, &common_);
+  return common_.condest;
 }
 
 double KluSolver::rcond() {

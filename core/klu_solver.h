@@ -26,6 +26,8 @@ class KluSolver {
   bool solve(double* b);
   // Reciprocal condition estimate of the last factorization.
   double rcond();
+  // 1-norm condition number estimate of the last factorized matrix (klu_condest).
+  double condest();
   int factorizations() const { return factorizations_; }
   int status() const { return common_.status; }
 

@@ -60,6 +60,13 @@ bool AugmentedSolver::velocities(const double* q, double t, double* v) {
   return true;
 }
 
+double AugmentedSolver::constraint_condition(const double* q) {
+  asm_.begin_values(values_.data());
+  assemble(q, false);
+  if (!klu_.factor(values_.data())) return INFINITY;
+  return klu_.condest();
+}
+
 PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, int max_iter,
                                                double regularization) {
   PositionSolveResult res;

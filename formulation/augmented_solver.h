@@ -34,6 +34,9 @@ class AugmentedSolver {
   const std::vector<int>& offsets() const { return offsets_; }
   int factorizations() const { return klu_.factorizations(); }
   double last_rcond() { return klu_.rcond(); }
+  // 1-norm condition estimate of [I Phi_q^T; Phi_q 0] at q: large near a singular configuration
+  // (a lost or gained degree of freedom), about the ratio of extreme singular values of Phi_q.
+  double constraint_condition(const double* q);
 
  private:
   void assemble(const double* q, bool with_mass, double regularization = 0.0);

@@ -190,6 +190,7 @@ double Index3Dae::consistent_output(double t_in, const double* y, const double* 
   // order of magnitude less accurate than these.
   constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
   const double violation = max_abs(out_phi_.data(), nc_);
+  if (track_condition) track_conditioning(t, q.data());
   if (!project) {
     aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
     return violation;
@@ -203,6 +204,14 @@ double Index3Dae::consistent_output(double t_in, const double* y, const double* 
   if (vviol > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
   aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
   return violation;
+}
+
+void Index3Dae::track_conditioning(double t, const double* q) {
+  const double c = aug_.constraint_condition(q);
+  if (c > max_condition) {
+    max_condition = c;
+    max_condition_time = t;
+  }
 }
 
 }  // namespace mbdae

@@ -61,6 +61,10 @@ class Index3Dae : public DaeProblem {
   std::vector<char> modes;         // per force: wheel in contact
   double max_position_violation = 0;  // over accepted steps (integrator's own solution)
   double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
+  // Conditioning of the constraints along the run (computed at output samples when
+  // track_condition is set: one extra factorization per sample).
+  bool track_condition = false;
+  double max_condition = 0.0, max_condition_time = 0.0;
   int nq() const { return nq_; }
   int nc() const { return nc_; }
   const System& system() const { return sys_; }
@@ -68,6 +72,7 @@ class Index3Dae : public DaeProblem {
 
  private:
   void assemble(double t, double cj, const double* y, const double* yp);
+  void track_conditioning(double t, const double* q);
   const System& sys_;
   std::vector<int> offsets_;
   int nq_, nc_;
