@@ -198,6 +198,7 @@ TEST(Suspension, BallCut5IsFlaggedAsRedundant) {
   Scene scene = load_scene(path);
   RunOptions o;
   o.verbose = false;
+  o.progress = false;
   try {
     run_scene(scene, o);
     ADD_FAILURE() << "redundancy not reported";
@@ -221,6 +222,7 @@ TEST(Suspension, FreeOscillationConservesEnergy) {
   RunOptions o;
   o.keep_rows = true;
   o.verbose = false;
+  o.progress = false;
   const RunOutcome r = run_scene(
       load_scene(std::string(MBDAE_SOURCE_DIR) + "/verification/suspension/scenes/free_oscillation.yaml"), o);
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
