@@ -311,6 +311,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         stats["residual_evaluations"] = st.residual_evals;
         stats["jacobian_evaluations"] = st.jacobian_evals;
         stats["klu_factorizations"] = st.linear_setups;
+        stats["klu_fresh_factorizations"] = st.fresh_factorizations;
         stats["error_test_failures"] = st.error_test_failures;
         stats["nonlinear_iterations"] = st.nonlinear_iterations;
         stats["nonlinear_failures"] = st.nonlinear_failures;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/klu_linear_solver.h"
 
 namespace mbdae {
 namespace {
@@ -126,7 +127,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   problem.error_test_mask(N_VGetArrayPointer(id));
 
   SUNMatrix jac = SUNSparseMatrix(n, n, std::max(1, pattern.nnz()), CSC_MAT, ctx);
-  SUNLinearSolver ls = SUNLinSol_KLU(y, jac, ctx);
+  SUNLinearSolver ls = make_klu_linear_solver(pattern, ctx);
   void* mem = IDACreate(ctx);
   UserData ud{&problem, &pattern, mem, o.rtol, o.atol,
               o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0)};
@@ -303,6 +304,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     collect(mem, stats);
     stats.t_reached = t;
   }
+  stats.fresh_factorizations = klu_linear_solver_fresh_factorizations(ls);
   (void)t_next_sample;
   std::memcpy(y0.data(), N_VGetArrayPointer(y), n * sizeof(double));
   std::memcpy(yp0.data(), N_VGetArrayPointer(yp), n * sizeof(double));

@@ -1,4 +1,4 @@
-// SUNDIALS IDA on a DaeProblem with the SUNLinSol_KLU sparse direct solver.
+// SUNDIALS IDA on a DaeProblem with a KLU sparse direct solver (core/klu_linear_solver.h).
 //
 // Integration runs in one-step mode; output samples are interpolated from IDA's history
 // (IDAGetDky), so sampling never shortens a step. Breakpoints are hit exactly with a stop time;
@@ -30,6 +30,7 @@ struct IdaStats {
   long steps = 0, residual_evals = 0, jacobian_evals = 0, linear_setups = 0;
   long error_test_failures = 0, nonlinear_iterations = 0, nonlinear_failures = 0;
   long restarts = 0;
+  long fresh_factorizations = 0;  // KLU factorizations with a new pivot order (others refactor)
   std::vector<double> event_times;      // located switching events
   std::vector<double> breakpoint_times;  // stops at input discontinuities
   double cpu_seconds = 0;

@@ -29,16 +29,24 @@ bool KluSolver::factor(const double* values) {
   values_.assign(values, values + pattern_.nnz());
   ++factorizations_;
   if (numeric_) {
-    // Reuse the pivot order; refactor and check the pivot growth (rcond) stays sane.
+    // Reuse the pivot order. A fresh factorization only when the pivot ratio is both small and
+    // degraded relative to the last fresh one: the absolute ratio of a multibody saddle-point
+    // matrix can be tiny by nature (massless links, mixed units: 1e-15 for the suspension's
+    // Newton matrix), so an absolute test alone would refactor from scratch every time.
     if (klu_refactor(pattern_.colptr.data(), pattern_.rowind.data(), values_.data(), symbolic_,
                      numeric_, &common_) &&
-        klu_rcond(symbolic_, numeric_, &common_) && common_.rcond > 1e-14)
+        klu_rcond(symbolic_, numeric_, &common_) &&
+        (common_.rcond > 1e-14 || common_.rcond > 1e-3 * fresh_rcond_))
       return true;
     free_numeric();
   }
+  ++full_factorizations_;
   numeric_ = klu_factor(pattern_.colptr.data(), pattern_.rowind.data(), values_.data(), symbolic_,
                         &common_);
-  return numeric_ != nullptr && common_.status == KLU_OK;
+  if (numeric_ == nullptr || common_.status != KLU_OK) return false;
+  klu_rcond(symbolic_, numeric_, &common_);
+  fresh_rcond_ = common_.rcond;
+  return true;
 }
 
 bool KluSolver::solve(double* b) {

@@ -1,6 +1,7 @@
 // Sparse LU by SuiteSparse KLU: symbolic analysis once per pattern, numeric factorization
 // (klu_factor) the first time and klu_refactor (same pivot order) afterwards, falling back to a
-// fresh factorization when the reused pivots become poor.
+// fresh factorization when the reused pivots degrade (pivot ratio below 1e-14 and below 1e-3 of
+// the fresh one's).
 #pragma once
 
 #include <klu.h>
@@ -29,6 +30,7 @@ class KluSolver {
   // 1-norm condition number estimate of the last factorized matrix (klu_condest).
   double condest();
   int factorizations() const { return factorizations_; }
+  int full_factorizations() const { return full_factorizations_; }
   int status() const { return common_.status; }
 
  private:
@@ -38,7 +40,8 @@ class KluSolver {
   klu_numeric* numeric_ = nullptr;
   CscPattern pattern_;
   std::vector<double> values_;
-  int factorizations_ = 0;
+  int factorizations_ = 0, full_factorizations_ = 0;
+  double fresh_rcond_ = 0;  // pivot ratio of the last fresh factorization
 };
 
 }  // namespace mbdae

@@ -1,6 +1,7 @@
 #include "formulation/mechanics.h"
 
 #include <cmath>
+#include <cstdlib>
 
 namespace mbdae {
 namespace {
@@ -233,6 +234,29 @@ void assemble_force_derivatives(const System& sys, const std::vector<char>& mode
   }
 }
 
+// Whether local column l of row r of a constraint can be non-zero: orientation-only equations
+// (norm, dot-1, rotation coordinates) do not depend on r; row k of a point constraint depends
+// on r only through r_k. Leaving the structural zeros out of the pattern shrinks the sparse LU.
+static bool structurally_nonzero(const Constraint& c, int r, int l) {
+  const int local = l % 7;
+  if (local >= 3) return c.type != Constraint::Type::kNorm || l < 7;
+  switch (c.type) {
+    case Constraint::Type::kNorm:
+    case Constraint::Type::kDot1: return false;
+    case Constraint::Type::kCoordinate: return !c.coord.rotation;
+    case Constraint::Type::kPoint: {
+      int comp = -1;
+      for (int k = 0, row = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) {
+          if (row == r) comp = k;
+          ++row;
+        }
+      return local == comp;
+    }
+    default: return true;
+  }
+}
+
 void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off,
                                   const double* q, double scale, int row0, int col0, int row0t,
                                   int col0t, SparseAssembler& a) {
@@ -243,7 +267,7 @@ void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off
     for (int r = 0; r < c.rows(); ++r)
       for (int l = 0; l < 14; ++l) {
         const int g = global_index(c.bi, c.bj, l);
-        if (g < 0) continue;
+        if (g < 0 || !structurally_nonzero(c, r, l)) continue;
         if (row0 >= 0) a.add(row0 + off[k] + r, col0 + g, scale * rows[r](l));
         if (row0t >= 0) a.add(row0t + g, col0t + off[k] + r, rows[r](l));
       }

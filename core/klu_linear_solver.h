@@ -1,0 +1,21 @@
+// A SUNDIALS linear solver (SUNLinearSolver, direct) on mbdae's KluSolver, for IDA's Newton
+// iteration. Unlike SUNLinSol_KLU, which refactors from scratch whenever KLU's pivot ratio falls
+// below eps^(2/3) (the suspension's index-3 Newton matrix sits at 1e-15 by nature), it reuses the
+// pivot order until the ratio degrades relative to the last fresh factorization: no fresh
+// factorization and no allocation in the step loop.
+#pragma once
+
+#include <sundials/sundials_linearsolver.h>
+
+#include "core/sparse_assembler.h"
+
+namespace mbdae {
+
+class KluSolver;
+
+// The matrix given to setup must be a CSC SUNSparseMatrix with `pattern`.
+SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx);
+// Factorization counts of a solver made by make_klu_linear_solver.
+int klu_linear_solver_fresh_factorizations(SUNLinearSolver s);
+
+}  // namespace mbdae
