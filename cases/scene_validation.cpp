@@ -394,8 +394,9 @@ struct Validator {
       }
       if (f.type == ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&
           same_rigid_body(f.body1, kGround))
-        report(f.where, "body", who + "wheel contact on '" + f.body1 + "', which is fixed to ground " +
-                                    (f.body1 == kGround ? "" : "(its joints to ground are locked or welds)"));
+        report(f.where, "body", who + (f.body1 == kGround ? std::string("a wheel contact needs a moving body, not ground")
+                                                          : "wheel contact on '" + f.body1 +
+                                                                "', which is fixed to ground (its joints to ground are locked or welds)"));
       if (f.type == ForceSpec::Type::kUser && !f.law.empty()) {
         const UserForceLaw* law = find_force_law(f.law);
         if (!law) {

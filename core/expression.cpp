@@ -1,5 +1,6 @@
 #include "core/expression.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -140,6 +141,22 @@ Expression Expression::compile(const std::string& text,
   p.expr();
   p.skip();
   if (p.pos != text.size()) p.fail("unexpected text");
+  // evaluate() works on a fixed stack of 64 values: refuse deeper expressions here.
+  int depth = 0, max_depth = 0;
+  for (const Instr& in : p.code) {
+    switch (in.op) {
+      case Op::kConst:
+      case Op::kVar: ++depth; break;
+      case Op::kNeg:
+      case Op::kCall1: break;
+      default: --depth; break;
+    }
+    max_depth = std::max(max_depth, depth);
+  }
+  if (max_depth > 64)
+    throw ExpressionError("expression nested too deeply (needs " + std::to_string(max_depth) +
+                              " operand slots, at most 64) in '" + text + "'",
+                          0);
   Expression e;
   e.code = std::move(p.code);
   e.source = text;

@@ -1,5 +1,7 @@
 #include "core/output.h"
 
+#include "core/errors.h"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -54,10 +56,10 @@ void prepare_output_folder(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (!std::filesystem::is_directory(dir))
-    throw std::runtime_error("output folder '" + dir + "' cannot be created");
+    throw ModelError("", 0, "--out", "output folder '" + dir + "' cannot be created");
   const std::string probe = dir + "/.mbdae_write_test";
   std::FILE* f = std::fopen(probe.c_str(), "w");
-  if (!f) throw std::runtime_error("output folder '" + dir + "' is not writable");
+  if (!f) throw ModelError("", 0, "--out", "output folder '" + dir + "' is not writable");
   std::fclose(f);
   std::remove(probe.c_str());
 }

@@ -35,7 +35,8 @@ class CsvWriter {
 // Writes JSON to path atomically (temporary name, then rename).
 void write_json_file(const std::string& path, const nlohmann::ordered_json& j);
 
-// Checks that a folder exists (creating it) and is writable; throws std::runtime_error if not.
+// Checks that a folder exists (creating it) and is writable; throws ModelError (field --out,
+// exit code 2: an input error found before any solve) if not.
 void prepare_output_folder(const std::string& dir);
 
 }  // namespace mbdae

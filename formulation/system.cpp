@@ -440,8 +440,13 @@ System build_system(const Model& model) {
     return {&it->second, it->second.local_point(pt->second)};
   };
   for (const auto& cut : model.cuts) {
-    auto [f1, s1] = point_of(cut.body1, cut.point1, cut.where, "body1");
-    auto [f2, s2] = point_of(cut.body2, cut.point2, cut.where, "body2");
+    // (pairs unpacked by hand: lambdas below capture them, which clang 14 refuses for
+    // structured bindings)
+    const auto p1 = point_of(cut.body1, cut.point1, cut.where, "body1");
+    const auto p2 = point_of(cut.body2, cut.point2, cut.where, "body2");
+    const BodyFrame* f1 = p1.first;
+    const BodyFrame* f2 = p2.first;
+    const Vec3 s1 = p1.second, s2 = p2.second;
     if (f1->body == f2->body)
       fail(cut.where, "body2", "cut '" + cut.name + "' joins two parts of the same rigid body");
     auto add = [&](Constraint c, const std::string& what) {

@@ -33,7 +33,12 @@ san=(-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 cxxflags=(-std=c++17 -O1 -g "${san[@]}" -fsanitize=fuzzer-no-link
   -I"$root" -I/usr/include/eigen3 -I/usr/include/suitesparse
   -DMBDAE_FUZZ_SCENE_PATH="\"$here/scene.yaml\"" -Wno-unused-command-line-argument)
-libs=(-lyaml-cpp -lsundials_ida -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
+# Libraries: yaml-cpp and every find_library(VAR name ...) of the top-level CMakeLists.txt.
+libs=(-lyaml-cpp)
+for l in $(sed -n 's/^[[:space:]]*find_library([[:space:]]*[A-Za-z_0-9]*[[:space:]][[:space:]]*\([A-Za-z_0-9.+-]*\).*/\1/p' "$root/CMakeLists.txt"); do
+  libs+=("-l$l")
+done
+[[ ${#libs[@]} -gt 1 ]] || libs+=(-lsundials_ida -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
 
 # Sources: those of the libraries mbdae_core, mbdae_formulation and mbdae_scene as listed in the
 # top-level CMakeLists.txt (all of core/, formulation/ and the loader if that cannot be read).

@@ -511,7 +511,16 @@ TEST(SceneValidation, WheelContactOnGround) {
   const std::string t = with("stiffness: 10, free_length: 0.5}",
                              "stiffness: 10, free_length: 0.5}\n"
                              "  - {name: tyre, type: wheel_contact, body: ground, stiffness: 1e5, radius: 0.3}");
-  expect_one(t, line_of(t, "name: tyre"), "body", "fixed to ground");
+  expect_one(t, line_of(t, "name: tyre"), "body", "a wheel contact needs a moving body, not ground");
+}
+
+TEST(SceneValidation, WheelContactOnLockedBody) {
+  std::string t = with("stiffness: 10, free_length: 0.5}",
+                       "stiffness: 10, free_length: 0.5}\n"
+                       "  - {name: tyre, type: wheel_contact, body: bob, stiffness: 1e5, radius: 0.3}");
+  t = with("theta: {initial_deg: 30}", "theta: {initial_deg: 30, mode: locked}", t);
+  t = with("hold: [theta], release: [theta], unknowns: [spring.free_length]", "hold: []", t);
+  expect_one(t, line_of(t, "name: tyre"), "body", "wheel contact on 'bob', which is fixed to ground");
 }
 
 TEST(SceneValidation, UnregisteredForceLaw) {
