@@ -108,7 +108,8 @@ void assemble_hessian_vector_rows(const System& sys, const std::vector<int>& off
     const Vec14 x2 = w2 ? gather_local(w2, c.bi, c.bj) : Vec14::Zero();
     for (int r = 0; r < c.rows(); ++r) {
       // H symmetric: row r of d(Phi_q w)/dq is w^T H_r = (H_r w)^T.
-      const Vec14 hw = s1 * (h[r] * x1) + (w2 ? s2 * (h[r] * x2) : Vec14::Zero());
+      Vec14 hw = s1 * (h[r] * x1);
+      if (w2) hw += s2 * (h[r] * x2);
       for (int l = 0; l < 14; ++l)
         if (in_pattern(c, l)) a.add(row0 + off[k] + r, col0 + global_index(c.bi, c.bj, l), hw[l]);
     }

@@ -71,6 +71,7 @@ void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
 
 int GglDae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
   const double t = input_time(t_in);
+  newton_cj_ = cj;
   asm_.begin_values(values);
   assemble(t, cj, y, yp);
   return 0;
@@ -82,10 +83,11 @@ void GglDae::error_test_mask(double* id) const {
 
 void GglDae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
   const double noise = position_noise(y);
-  const double av = v_in_test_ ? atol : atol + noise / h;
+  const double aq = position_atol(y, atol);
+  const double av = v_in_test_ ? velocity_atol(h, y, atol) : atol + noise / h;
   const double al = mass_scale_ * (atol + noise / h) / h;
   const double am = (atol + noise) / h;
-  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
+  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < 2 * nq_ + nc_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
   for (int i = 2 * nq_ + nc_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + am);

@@ -67,6 +67,7 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
 
 int Index1Dae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
   const double t = input_time(t_in);
+  newton_cj_ = cj;
   asm_.begin_values(values);
   assemble(t, cj, y, yp);
   return 0;
@@ -79,7 +80,9 @@ void Index1Dae::error_test_mask(double* id) const {
 void Index1Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
   const double noise = position_noise(y);
   const double al = mass_scale_ * (atol + noise) / h;
-  for (int i = 0; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + atol);
+  const double aq = position_atol(y, atol), av = velocity_atol(h, y, atol);
+  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
+  for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 

@@ -40,6 +40,20 @@ double MultibodyDae::position_noise(const double* y) const {
   return 1e3 * 2.22e-16 * qmax;
 }
 
+double MultibodyDae::position_atol(const double* y, double atol) const {
+  double qmax = 0;
+  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
+  return std::fmax(atol, 10 * 2.22e-16 * qmax);
+}
+
+double MultibodyDae::velocity_atol(double h, const double* y, double atol) const {
+  double qmax = 0, vmax = 0;
+  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
+  for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
+  const double step = newton_cj_ > 0 ? 1.0 / newton_cj_ : h;
+  return std::fmax(atol, 10 * 2.22e-16 * std::fmax(vmax, qmax / step));
+}
+
 void MultibodyDae::switches(double t_in, const double* y, double* g) {
   const double t = input_time(t_in);
   for (size_t k = 0; k < switch_forces_.size(); ++k) {
@@ -106,22 +120,28 @@ void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, d
                          " (redundant constraints or an unconstrained massless body)");
 }
 
-double MultibodyDae::consistent_output(double t_in, const double* y, std::vector<double>& q,
-                                       std::vector<double>& v, std::vector<double>& a) {
+double MultibodyDae::consistent_output(double t_in, const double* y, const double* yp,
+                                       std::vector<double>& q, std::vector<double>& v,
+                                       std::vector<double>& a, bool project) {
   const double t = input_time(t_in);
   q.assign(y, y + nq_);
-  v.assign(y + nq_, y + 2 * nq_);
+  if (velocities_error_tested())
+    v.assign(y + nq_, y + 2 * nq_);
+  else
+    v.assign(yp, yp + nq_);
   a.resize(nq_);
-  // An interpolated sample violates the constraints by about the local error: project it back
-  // (positions, then velocities), skipping what already holds to rounding, then solve for the
-  // accelerations of that consistent state.
+  // An interpolated sample violates the constraints by about the local error. If asked, project
+  // it back (positions, then velocities), skipping what already holds to rounding. Then solve for
+  // the accelerations of the state (more accurate than interpolated ones).
   constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
   const double violation = max_abs(out_phi_.data(), nc_);
-  if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
-  velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
-  double vmax = 1.0;
-  for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
-  if (max_abs(out_phi_.data(), nc_) > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
+  if (project) {
+    if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
+    velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
+    double vmax = 1.0;
+    for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
+    if (max_abs(out_phi_.data(), nc_) > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
+  }
   aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
   return violation;
 }

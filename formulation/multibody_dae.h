@@ -47,10 +47,15 @@ class MultibodyDae : public DaeProblem {
 
   // Consistent initial values from the q and v in y (projected onto the constraints).
   virtual void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) = 0;
-  // Projects an interpolated (q, v) onto the constraint manifold (for output), then computes
-  // accelerations. Returns the position violation before projection.
-  double consistent_output(double t, const double* y, std::vector<double>& q,
-                           std::vector<double>& v, std::vector<double>& a);
+  // Output state from an interpolated (y, y'): optionally projected onto the constraint
+  // manifold (positions and velocities), then the accelerations solved from it. Returns the
+  // position violation of the interpolated y. (Same contract as Index3Dae::consistent_output.)
+  // Velocities are taken from y when they are in the error test (velocities_error_tested()),
+  // else from the derivative of the positions' interpolant, q' in y'.
+  double consistent_output(double t, const double* y, const double* yp, std::vector<double>& q,
+                           std::vector<double>& v, std::vector<double>& a, bool project);
+  // Whether v is in the local error test (then its interpolant is error-controlled).
+  virtual bool velocities_error_tested() const = 0;
 
   std::vector<char> modes;            // per force: wheel in contact
   double max_position_violation = 0;  // max |Phi| over accepted steps (integrator's own solution)
@@ -67,8 +72,20 @@ class MultibodyDae : public DaeProblem {
   void consistent_state(double t, double* q, double* v, double* a, double* lambda);
   // Label of the constraint owning stacked constraint row `row`.
   std::string constraint_label(int row) const;
-  // Noise floor of the positions: about 1e3 eps max(1, |q|).
+  // Rounding noise of the positions through the constraints: about 1e3 eps max(1, |q|).
   double position_noise(const double* y) const;
+  // Absolute tolerances never below what rounding lets the Newton iteration resolve (an atol
+  // under that asks for digits that do not exist): positions ten roundings of the largest
+  // coordinate; velocities ten roundings of the largest velocity, and ten roundings of the
+  // largest coordinate per step (a velocity below that moves no coordinate by a rounding within
+  // the step). The step is the integrator's own, 1/cj of the last Newton matrix (cj = alpha/h,
+  // alpha in [1, 2.3] for BDF orders 1-5), not the h of error_weights(): the driver passes a
+  // deliberately small h there (loose multiplier weights after failures), which would loosen
+  // the error test of v. Without the floor, an atol of 1e-15 fails on the suspension at rest,
+  // where v is rounding noise of about 1e-15 m/s. `h` is used before the first Newton matrix.
+  double position_atol(const double* y, double atol) const;
+  double velocity_atol(double h, const double* y, double atol) const;
+  double newton_cj_ = 0;  // cj of the last Newton matrix (set by the formulations' jacobian())
 
   const System& sys_;
   std::vector<int> offsets_;

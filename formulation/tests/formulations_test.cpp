@@ -4,10 +4,11 @@
 //     on a model with every constraint and force type (index 1: exact blocks exactly, the
 //     omitted d(gamma)/dq block measured);
 //  b. a compound pendulum through core/ida_driver integrate(): period against the elliptic
-//     integral and the trajectory against index 3, within what the tolerance promises;
+//     integral and the trajectory against an index-3 reference, within what the tolerance
+//     promises;
 //  c. constraint drift at position level: GGL at the Newton tolerance, index 1 with Baumgarte
 //     bounded (and growing without it);
-//  d. events (wheel contact) located at the same times as index 3.
+//  d. events (wheel contact): contact and lift-off times against the closed form.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -214,30 +215,46 @@ std::vector<double> downward_crossings(const std::vector<double>& t, const std::
   return out;
 }
 
-struct Run {
-  IdaStats stats;
-  std::vector<double> t, theta, rate, violation;  // violation: max |Phi| of each (interpolated) sample
-  double max_position_violation = 0, max_velocity_violation = 0, max_norm_drift = 0;
+// A formulation that also records, per third of the run, the largest |Phi| and |Phi_q v + Phi_t|
+// of the integrator's accepted steps.
+template <class Dae>
+struct Recording : Dae {
+  using Dae::Dae;
+  double t_end = 1;
+  double phi[3] = {0, 0, 0}, phi_dot[3] = {0, 0, 0};
+  void after_step(double t, const double* y) override {
+    const double p = this->max_position_violation, v = this->max_velocity_violation;
+    this->max_position_violation = this->max_velocity_violation = 0;
+    Dae::after_step(t, y);
+    const int k = std::min(2, static_cast<int>(3 * t / t_end));
+    phi[k] = std::max(phi[k], this->max_position_violation);
+    phi_dot[k] = std::max(phi_dot[k], this->max_velocity_violation);
+    this->max_position_violation = std::max(p, this->max_position_violation);
+    this->max_velocity_violation = std::max(v, this->max_velocity_violation);
+  }
 };
 
-// Integrates `dae` from the model's initial configuration at rest; samples theta (coordinate 0)
-// and its rate from the projected output, as run_scene does.
+struct RunResult {
+  IdaStats stats;
+  std::vector<double> t, x, rate;  // coordinate 0 and its rate at the samples
+  double max_position_violation = 0, max_norm_drift = 0;
+};
+
+// Integrates `dae` from the model's initial configuration at rest; samples coordinate 0 and its
+// rate from the projected output, as run_scene does.
 template <class Dae>
-Run integrate_model(Dae& dae, const IdaOptions& o) {
+RunResult integrate_model(Dae& dae, const IdaOptions& o) {
   const System& sys = dae.system();
-  Run run;
+  RunResult run;
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
   dae.modes = initial_modes(sys, y.data(), o.t0);
   dae.consistent_initial_values(o.t0, y, yp);
-  const std::vector<int> off = constraint_offsets(sys);
-  std::vector<double> q, v, a, phi(off.back());
-  run.stats = integrate(dae, o, y, yp, [&](double t, const double* yy, const double*) {
-    constraint_values(sys, off, yy, t, phi.data());
-    run.violation.push_back(max_abs(phi.data(), off.back()));
-    dae.consistent_output(t, yy, q, v, a);
+  std::vector<double> q, v, a;
+  run.stats = integrate(dae, o, y, yp, [&](double t, const double* yy, const double* yyp) {
+    dae.consistent_output(t, yy, yyp, q, v, a, true);
     run.t.push_back(t);
-    run.theta.push_back(coordinate_value(sys, 0, q.data()));
+    run.x.push_back(coordinate_value(sys, 0, q.data()));
     run.rate.push_back(coordinate_rate(sys, 0, q.data(), v.data()));
     return true;
   });
@@ -254,8 +271,8 @@ double exact_period() {
   return 4.0 * std::sqrt(i_pivot / (kMass * kG * kD)) * elliptic_k(std::sin(kTheta0 / 2));
 }
 
-double measured_period(const Run& r) {
-  const std::vector<double> c = downward_crossings(r.t, r.theta, r.rate);
+double measured_period(const RunResult& r) {
+  const std::vector<double> c = downward_crossings(r.t, r.x, r.rate);
   if (c.size() < 2) return 0;
   return (c.back() - c.front()) / static_cast<double>(c.size() - 1);
 }
@@ -270,39 +287,53 @@ TEST(Formulations, CompoundPendulumMatchesIndex3AndExactPeriod) {
   const System sys = build_system(testing::pendulum(kMass, kD, kIxx, kTheta0));
   const double period = exact_period();
   IdaOptions o;
-  o.t1 = 5.0 * period + 0.1;
+  o.t1 = 5.0 * period + 0.1;  // 5 periods, about 8 s
   o.output_step = 1e-3;
-  o.rtol = 1e-9;
-  o.atol = 1e-11;
+  // Reference: index 3 at rtol 1e-12 with a tight Newton test (period error 3.5e-10, theta
+  // within 3e-8 rad of GGL at rtol 1e-13).
+  IdaOptions oref = o;
+  oref.rtol = 1e-12;
+  oref.atol = 1e-14;
+  oref.nonlinear_convergence = 0.001;
+  Index3Dae ref_dae(sys, 2.0 / (1e-3 * 1e-3));
+  const RunResult ref = integrate_model(ref_dae, oref);
+  ASSERT_TRUE(ref.stats.ok) << ref.stats.message;
+  EXPECT_LT(std::fabs(measured_period(ref) - period) / period, 1e-8);
+
+  o.rtol = 1e-8;
+  o.atol = 1e-10;
   Index3Dae i3(sys, 2.0 / (1e-3 * 1e-3));
   GglDae ggl(sys);
   Index1Dae i1(sys);
-  const Run r3 = integrate_model(i3, o), rg = integrate_model(ggl, o), r1 = integrate_model(i1, o);
+  const RunResult r3 = integrate_model(i3, o), rg = integrate_model(ggl, o), r1 = integrate_model(i1, o);
   ASSERT_TRUE(r3.stats.ok) << r3.stats.message;
   ASSERT_TRUE(rg.stats.ok) << rg.stats.message;
   ASSERT_TRUE(r1.stats.ok) << r1.stats.message;
-  ASSERT_EQ(rg.t.size(), r3.t.size());
-  ASSERT_EQ(r1.t.size(), r3.t.size());
-  // What rtol promises: a local error per step of about rtol |y|, adding up over the ~N steps
-  // to a global phase error of at most ~ N rtol (BDF errors are not all of one sign, so the
-  // growth is well below that). The bound below, 1e3 rtol relative on the period (about
-  // 5e-7 s) and 1e3 rtol (rad) on theta at every sample, holds with a margin of about 10-100
-  // (measured values printed).
-  const double bound = 1e3 * o.rtol;
+  ASSERT_EQ(rg.t.size(), ref.t.size());
+  ASSERT_EQ(r1.t.size(), ref.t.size());
+  // What rtol promises: a local error per step below rtol |y| + atol in every error-tested
+  // component, here q and v. The global error is that local error carried along the ~3000
+  // steps; for this pendulum it is measured at 30-75 rtol in theta over 5 periods (rtol 1e-6 ..
+  // 1e-10) and below 3 rtol in the period. Bounds: theta within 200 rtol of the reference at
+  // every sample, period within 10 rtol of the elliptic-integral value.
+  // Index 3 controls q only: its velocities, hence its phase, are not error-controlled, and it
+  // misses both bounds by far at the same rtol (period error ~500 rtol); printed, not checked.
+  const double theta_bound = 200 * o.rtol, period_bound = 10 * o.rtol;
   struct {
     const char* name;
-    const Run* r;
-  } runs[] = {{"index3", &r3}, {"index2-ggl", &rg}, {"index1", &r1}};
-  for (const auto& [name, r] : runs) {
-    const double tp = measured_period(*r);
-    const double rel = (tp - period) / period;
-    const double dtheta = max_diff(r->theta, r3.theta);
-    std::printf("  %-10s %5ld steps %6ld residuals: period %.12f s (exact %.12f, rel. error %.2e), "
-                "max |theta - theta_index3| %.2e rad, max |Phi| %.2e\n",
-                name, r->stats.steps, r->stats.residual_evals, tp, period, rel, dtheta,
-                r->max_position_violation);
-    EXPECT_LT(std::fabs(rel), bound) << name;
-    EXPECT_LT(dtheta, bound) << name;
+    const RunResult* r;
+    bool checked;
+  } runs[] = {{"index3", &r3, false}, {"index2-ggl", &rg, true}, {"index1", &r1, true}};
+  for (const auto& [name, r, checked] : runs) {
+    const double rel = (measured_period(*r) - period) / period;
+    const double dtheta = max_diff(r->x, ref.x);
+    std::printf("  %-10s rtol %.0e: %5ld steps %6ld residuals: period rel. error %9.2e (bound %.0e), "
+                "max |theta - theta_ref| %.2e rad (bound %.0e), max |Phi| %.2e\n",
+                name, o.rtol, r->stats.steps, r->stats.residual_evals, rel, period_bound, dtheta,
+                theta_bound, r->max_position_violation);
+    if (!checked) continue;
+    EXPECT_LT(std::fabs(rel), period_bound) << name;
+    EXPECT_LT(dtheta, theta_bound) << name;
   }
 }
 
@@ -312,102 +343,119 @@ TEST(Formulations, ConstraintDrift) {
   const System sys = build_system(testing::pendulum(kMass, kD, kIxx, kTheta0));
   IdaOptions o;
   o.t1 = 30.0;
-  o.output_step = 1e-2;
+  o.output_step = 0;
   o.rtol = 1e-6;
   o.atol = 1e-8;
-  // GGL enforces Phi = 0 at every step: the violation is the Newton iteration's leftover,
-  // bounded by the Newton test (weighted corrections below 0.33 of the tolerance rtol|q| + atol).
-  GglDae ggl(sys);
-  const Run rg = integrate_model(ggl, o);
-  ASSERT_TRUE(rg.stats.ok) << rg.stats.message;
   double qmax = 0;
   for (double x : sys.q0) qmax = std::max(qmax, std::fabs(x));
   const double tol = o.rtol * std::max(1.0, qmax) + o.atol;
-  std::printf("  GGL over %.0f s at rtol %.0e: max |Phi| %.2e (tolerance %.1e), max |Phi_q v + Phi_t| "
-              "%.2e, max | |p| - 1 | %.2e\n",
+
+  // GGL enforces Phi = 0 and Phi' = 0 at every step: what is left is the Newton iteration's
+  // leftover, of the size of the Newton test (weighted corrections under 0.33 of rtol|q| + atol
+  // in RMS norm); measured 0.25 to 0.55 tol over builds. Bound: 2 tol.
+  Recording<GglDae> ggl(sys);
+  ggl.t_end = o.t1;
+  const RunResult rg = integrate_model(ggl, o);
+  ASSERT_TRUE(rg.stats.ok) << rg.stats.message;
+  std::printf("  GGL over %.0f s at rtol %.0e: max |Phi| %.2e (tolerance %.1e), max |Phi'| %.2e, "
+              "max | |p| - 1 | %.2e\n",
               o.t1, o.rtol, rg.max_position_violation, tol, ggl.max_velocity_violation, rg.max_norm_drift);
-  EXPECT_LT(rg.max_position_violation, tol);
+  EXPECT_LT(rg.max_position_violation, 2 * tol);
   EXPECT_LT(ggl.max_velocity_violation, 10 * tol);
 
-  // Index 1: the drift of Phi and Phi' is driven by each step's local error. With Baumgarte it
-  // settles to a bounded level; without (alpha = beta = 0) it grows with time.
-  auto late_over_early = [&](const Run& r) {
-    double early = 0, late = 0;
-    for (size_t i = 0; i < r.t.size(); ++i) {
-      double& m = r.t[i] < o.t1 / 2 ? early : late;
-      m = std::max(m, r.violation[i]);
-    }
-    return std::pair<double, double>(early, late);
-  };
-  Index1Dae stab(sys);
-  Index1Dae plain(sys, 1.0, BaumgarteParameters{0.0, 0.0});
-  const Run rs = integrate_model(stab, o), rp = integrate_model(plain, o);
+  // Index 1: the constraints are integrated, not enforced: Phi and Phi' are driven by each
+  // step's local error. With Baumgarte (default alpha = beta = 20/s) they settle at about the
+  // tolerance; without (alpha = beta = 0) Phi grows with time.
+  Recording<Index1Dae> stab(sys);
+  Recording<Index1Dae> plain(sys, 1.0, BaumgarteParameters{0.0, 0.0});
+  stab.t_end = plain.t_end = o.t1;
+  const RunResult rs = integrate_model(stab, o), rp = integrate_model(plain, o);
   ASSERT_TRUE(rs.stats.ok) << rs.stats.message;
   ASSERT_TRUE(rp.stats.ok) << rp.stats.message;
-  const auto [se, sl] = late_over_early(rs);
-  const auto [pe, pl] = late_over_early(rp);
-  std::printf("  index1 alpha = beta = %.0f/s: max |Phi| %.2e (first half %.2e, second half %.2e), "
-              "max |Phi'| %.2e\n",
-              stab.baumgarte().alpha, rs.max_position_violation, se, sl, stab.max_velocity_violation);
-  std::printf("  index1 without stabilization: max |Phi| %.2e (first half %.2e, second half %.2e), "
-              "max |Phi'| %.2e\n",
-              rp.max_position_violation, pe, pl, plain.max_velocity_violation);
-  // Bounded: no growth from the first to the second half, and at the tolerance's level.
-  EXPECT_LT(rs.max_position_violation, 10 * tol);
-  EXPECT_LT(sl, 2 * se + tol);
-  // Unstabilized drift grows and is larger than the stabilized one.
-  EXPECT_GT(pl, pe);
-  EXPECT_GT(rp.max_position_violation, rs.max_position_violation);
+  for (const auto* d : {&stab, &plain})
+    std::printf("  index1 alpha = beta = %2.0f/s: max |Phi| per 10 s %.2e %.2e %.2e, max |Phi'| "
+                "per 10 s %.2e %.2e %.2e\n",
+                d->baumgarte().alpha, d->phi[0], d->phi[1], d->phi[2], d->phi_dot[0],
+                d->phi_dot[1], d->phi_dot[2]);
+  // Bounded: every third at the tolerance's level (measured up to 1.5 tol).
+  for (int k = 0; k < 3; ++k) EXPECT_LT(stab.phi[k], 5 * tol) << "third " << k;
+  // Unstabilized: grows from third to third, to well above the stabilized level.
+  EXPECT_GT(plain.phi[1], plain.phi[0]);
+  EXPECT_GT(plain.phi[2], plain.phi[1]);
+  EXPECT_GT(plain.phi[2], 100 * tol);
 }
 
 // --- d. Events ----------------------------------------------------------------------------------
 
 // A wheel on a vertical slider, dropped from 0.2 m above ground contact: it bounces on the tyre
 // spring (no damping), so contact and lift-off alternate as events.
+constexpr double kWheelMass = 10.0, kTyreStiffness = 1e5, kRadius = 0.3, kDrop = 0.2;
 Model bouncing_wheel() {
   Model m;
   m.name = "bouncing_wheel";
-  m.bodies.push_back(testing::make_body("wheel", 10.0, Vec3::Zero(), Vec3(0.3, 0.5, 0.3)));
+  m.bodies.push_back(testing::make_body("wheel", kWheelMass, Vec3::Zero(), Vec3(0.3, 0.5, 0.3)));
   m.joints.push_back(testing::make_joint("slider", kGround, "wheel", Vec3::Zero(), "T3 ", {"z"}));
-  testing::add_coordinate(m, "z", 0.5);
+  testing::add_coordinate(m, "z", kRadius + kDrop);
   ForceSpec w;
   w.name = "tyre";
   w.type = ForceSpec::Type::kWheelContact;
   w.body1 = "wheel";
-  w.stiffness = 1e5;
-  w.radius = 0.3;
+  w.stiffness = kTyreStiffness;
+  w.radius = kRadius;
   w.axis = Vec3(0, 1, 0);
   w.ground = TimeFunction::constant(0.0);
   m.forces.push_back(w);
   return m;
 }
 
-TEST(Formulations, WheelContactEventsMatchIndex3) {
+// Event times in closed form: free fall to contact, then half a harmonic oscillation about the
+// static deflection m g / K (omega = sqrt(K/m)) until lift-off, then a ballistic flight back up
+// and down with the same speed; and so on.
+std::vector<double> bouncing_wheel_events(double t_end) {
+  const double w = std::sqrt(kTyreStiffness / kWheelMass), x0 = kWheelMass * kG / kTyreStiffness;
+  const double v0 = std::sqrt(2 * kG * kDrop), amp = std::sqrt(x0 * x0 + v0 * v0 / (w * w));
+  const double contact = 2 * (kPi - std::acos(x0 / amp)) / w, flight = 2 * v0 / kG;
+  std::vector<double> t{std::sqrt(2 * kDrop / kG)};
+  while (true) {
+    const double next = t.back() + (t.size() % 2 ? contact : flight);
+    if (next > t_end) break;
+    t.push_back(next);
+  }
+  return t;
+}
+
+TEST(Formulations, WheelContactEventsMatchClosedForm) {
   const System sys = build_system(bouncing_wheel());
   IdaOptions o;
   o.t1 = 1.5;
   o.output_step = 1e-2;
   o.rtol = 1e-9;
   o.atol = 1e-11;
+  const std::vector<double> exact = bouncing_wheel_events(o.t1);
+  ASSERT_EQ(exact.size(), 6u);
   Index3Dae i3(sys, 10.0 / (1e-3 * 1e-3));
   GglDae ggl(sys);
   Index1Dae i1(sys);
-  const Run r3 = integrate_model(i3, o), rg = integrate_model(ggl, o), r1 = integrate_model(i1, o);
+  const RunResult r3 = integrate_model(i3, o), rg = integrate_model(ggl, o), r1 = integrate_model(i1, o);
   ASSERT_TRUE(r3.stats.ok && rg.stats.ok && r1.stats.ok);
-  // Free fall of 0.2 m: first contact at sqrt(2 h / g).
-  ASSERT_GE(r3.stats.event_times.size(), 4u);
-  EXPECT_NEAR(r3.stats.event_times[0], std::sqrt(2 * 0.2 / kG), 1e-6);
-  for (const Run* r : {&rg, &r1}) {
-    ASSERT_EQ(r->stats.event_times.size(), r3.stats.event_times.size());
-    for (size_t k = 0; k < r3.stats.event_times.size(); ++k)
-      EXPECT_NEAR(r->stats.event_times[k], r3.stats.event_times[k], 1e-6) << "event " << k;
+  // Measured at rtol 1e-9: GGL 5e-8 s, index 1 9e-8 s, index 3 2.5e-5 s (its velocities, and
+  // so the flight times, are not error-controlled). Bound for GGL and index 1: 1e-6 s.
+  struct {
+    const char* name;
+    const RunResult* r;
+    bool checked;
+  } runs[] = {{"index3", &r3, false}, {"index2-ggl", &rg, true}, {"index1", &r1, true}};
+  for (const auto& [name, r, checked] : runs) {
+    double worst = 0;
+    for (size_t k = 0; k < std::min(exact.size(), r->stats.event_times.size()); ++k)
+      worst = std::max(worst, std::fabs(r->stats.event_times[k] - exact[k]));
+    std::printf("  %-10s %zu events (exact %zu), %4ld steps, max |t_event - exact| %.2e s\n", name,
+                r->stats.event_times.size(), exact.size(), r->stats.steps, worst);
+    EXPECT_EQ(r->stats.restarts, static_cast<long>(exact.size())) << name;
+    if (!checked) continue;
+    ASSERT_EQ(r->stats.event_times.size(), exact.size()) << name;
+    EXPECT_LT(worst, 1e-6) << name;
   }
-  std::printf("  %zu events; first at %.9f s (free fall %.9f s); index2-ggl, index1 - index3 at the "
-              "last event: %.2e, %.2e s; max |z - z_index3|: %.2e, %.2e m\n",
-              r3.stats.event_times.size(), r3.stats.event_times[0], std::sqrt(2 * 0.2 / kG),
-              rg.stats.event_times.back() - r3.stats.event_times.back(),
-              r1.stats.event_times.back() - r3.stats.event_times.back(), max_diff(rg.theta, r3.theta),
-              max_diff(r1.theta, r3.theta));
 }
 
 }  // namespace
