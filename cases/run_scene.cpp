@@ -264,6 +264,10 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         auto integrate_dae = [&](auto& dae) -> bool {
         using Dae = std::decay_t<decltype(dae)>;
         dae.modes = initial_modes(sys, q.data(), step.t0);
+          // Output samples solve for accelerations only if a sensor reports one.
+          dae.output_accelerations = false;
+          for (const auto& s : sys.sensors)
+            if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
         std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
         std::copy(q.begin(), q.end(), y.begin());
         try {

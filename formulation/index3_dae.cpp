@@ -183,16 +183,17 @@ double Index3Dae::consistent_output(double t_in, const double* y, const double* 
   // 9.6e-9 against 1.6e-8).
   (void)yp;
   v.assign(y + nq_, y + 2 * nq_);
-  a.resize(nq_);
+  a.resize(nq_, 0.0);
   // An interpolated sample violates the constraints by about the local error. If asked, project
   // it back (positions, then velocities), skipping what already holds to rounding. Then solve for
   // the accelerations of the state: interpolated accelerations of an index-3 solution are an
   // order of magnitude less accurate than these.
   constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
   const double violation = max_abs(out_phi_.data(), nc_);
-  if (track_condition) track_conditioning(t, q.data());
+  // The condition estimate costs a factorization: every tenth sample is enough to see it grow.
+  if (track_condition && (condition_samples_++ % 10) == 0) track_conditioning(t, q.data());
   if (!project) {
-    aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+    if (output_accelerations) aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
     return violation;
   }
   if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
@@ -202,7 +203,7 @@ double Index3Dae::consistent_output(double t_in, const double* y, const double* 
   for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
   for (int i = 0; i < nc_; ++i) vviol = std::fmax(vviol, std::fabs(out_phi_[i] + out_phi2_[i]));
   if (vviol > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
-  aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+  if (output_accelerations) aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
   return violation;
 }
 

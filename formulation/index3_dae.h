@@ -60,6 +60,8 @@ class Index3Dae : public DaeProblem {
 
   std::vector<char> modes;         // per force: wheel in contact
   double max_position_violation = 0;  // over accepted steps (integrator's own solution)
+  // Solve accelerations for output samples (only needed by acceleration sensors).
+  bool output_accelerations = true;
   double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
   // Conditioning of the constraints along the run (computed at output samples when
   // track_condition is set: one extra factorization per sample).
@@ -79,6 +81,7 @@ class Index3Dae : public DaeProblem {
   double scale_;
   double mass_scale_ = 1e-3;
   double segment_end_ = 1e300;
+  long condition_samples_ = 0;
   std::vector<int> switch_forces_;
   SparseAssembler asm_;
   AugmentedSolver aug_;

@@ -129,7 +129,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
     v.assign(y + nq_, y + 2 * nq_);
   else
     v.assign(yp, yp + nq_);
-  a.resize(nq_);
+  a.resize(nq_, 0.0);
   // An interpolated sample violates the constraints by about the local error. If asked, project
   // it back (positions, then velocities), skipping what already holds to rounding. Then solve for
   // the accelerations of the state (more accurate than interpolated ones).
@@ -142,7 +142,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
     for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
     if (max_abs(out_phi_.data(), nc_) > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
   }
-  aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+  if (output_accelerations) aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
   return violation;
 }
 

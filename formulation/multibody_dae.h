@@ -60,6 +60,8 @@ class MultibodyDae : public DaeProblem {
   std::vector<char> modes;            // per force: wheel in contact
   double max_position_violation = 0;  // max |Phi| over accepted steps (integrator's own solution)
   double max_velocity_violation = 0;  // max |Phi_q v + Phi_t| over accepted steps
+  // Solve accelerations for output samples (only needed by acceleration sensors).
+  bool output_accelerations = true;
   double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
   int nq() const { return nq_; }
   int nc() const { return nc_; }
