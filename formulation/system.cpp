@@ -163,15 +163,21 @@ System build_system(const Model& model) {
   // Order bodies from ground outwards; detect loops and bodies with no path to ground.
   std::vector<const JointSpec*> order;
   std::set<std::string> placed = {kGround};
-  while (order.size() < model.joints.size()) {
-    bool progress = false;
-    for (const auto& j : model.joints)
-      if (!placed.count(j.child) && placed.count(j.parent)) {
-        order.push_back(&j);
-        placed.insert(j.child);
-        progress = true;
-      }
-    if (!progress) break;
+  {
+    // Breadth-first from ground over the joints by parent (linear in the number of joints).
+    std::map<std::string, std::vector<const JointSpec*>> by_parent;
+    for (const auto& j : model.joints) by_parent[j.parent].push_back(&j);
+    std::vector<std::string> frontier = {kGround};
+    while (!frontier.empty()) {
+      std::vector<std::string> next;
+      for (const auto& parent : frontier)
+        for (const JointSpec* j : by_parent[parent])
+          if (placed.insert(j->child).second) {
+            order.push_back(j);
+            next.push_back(j->child);
+          }
+      frontier.swap(next);
+    }
   }
   for (const auto& b : model.bodies)
     if (!placed.count(b.name)) {
@@ -232,11 +238,14 @@ System build_system(const Model& model) {
   // Composite mass properties of each moving host, in its own frame.
   std::map<std::string, int> host_index;
   std::map<std::string, Vec3> host_com;
+  // Members of each host, gathered once (a loop over all bodies per host is quadratic).
+  std::map<std::string, std::vector<const BodySpec*>> members;
+  for (const auto& b : model.bodies) members[host_of[b.name]].push_back(&b);
   for (const auto& h : hosts) {
     double m = 0;
     Vec3 mc = Vec3::Zero();
-    for (const auto& b : model.bodies)
-      if (host_of[b.name] == h) {
+    for (const BodySpec* bp : members[h])
+      if (const BodySpec& b = *bp; true) {
         const Pose& p = in_host[b.name];
         m += b.mass;
         mc += b.mass * (p.rot * b.com + p.pos);
@@ -245,8 +254,8 @@ System build_system(const Model& model) {
     Mat3 inertia = Mat3::Zero();
     SystemBody sb;
     sb.name = h;
-    for (const auto& b : model.bodies)
-      if (host_of[b.name] == h) {
+    for (const BodySpec* bp : members[h])
+      if (const BodySpec& b = *bp; true) {
         const Pose& p = in_host[b.name];
         const Vec3 d = p.rot * b.com + p.pos - com;
         inertia += p.rot * b.inertia * p.rot.transpose() +
@@ -291,6 +300,7 @@ System build_system(const Model& model) {
   }
 
   // --- Tree joints -> Cartesian constraints -------------------------------------------------
+  std::set<std::string> coordinate_names;
   for (const JointSpec* jp : order) {
     const JointSpec& j = *jp;
     const BodyFrame& fp = sys.frames[j.parent];
@@ -342,7 +352,7 @@ System build_system(const Model& model) {
         f.child_frame = parts.rotations_first;
       }
       jc.function = f;
-      if (sys.coordinate_index(jc.name) >= 0)
+      if (!coordinate_names.insert(jc.name).second)
         fail(j.where, "coordinates", "coordinate '" + jc.name + "' is used by two joints");
       sys.coordinates.push_back(jc);
     }
@@ -422,7 +432,7 @@ System build_system(const Model& model) {
     sys.constraints.push_back(c);
   }
   for (const auto& [name, cs] : model.coordinates) {
-    if (sys.coordinate_index(name) < 0)
+    if (!coordinate_names.count(name))
       fail(cs.where, name, "coordinate '" + name + "' belongs to no joint");
   }
 
