@@ -1,6 +1,6 @@
 // Short versions of the stiff and extreme cases (verification/studies/extreme/*.yaml, documented
 // in docs/extreme-cases.md): the fast scenes run through run_scene, each asserting its documented
-// outcome. Bounds are the measured values (docs/extreme-cases.md) with a margin of about 3 to 10.
+// outcome. Bounds are the measured values (docs/extreme-cases.md) with a margin of about 3 to 50.
 // A test here failing means the documented outcome changed: update the page (run_extreme.sh)
 // together with the test.
 #include <gtest/gtest.h>
@@ -83,8 +83,9 @@ bool all_finite(const RunOutcome& r) {
 
 // --- Tolerances ---------------------------------------------------------------------------------
 
-// rtol 1e-2 (atol 1e-8): runs to the end; wheel_z within 3e-2 m of a tight run (measured 8e-3 m:
-// the wheel lands at a visibly different time), constraints still held to 1e-3 (measured 4e-5).
+// rtol 1e-2 (atol 1e-8): runs to the end; wheel_z within 3e-2 m of a tight run (measured 7.4e-3 m:
+// the wheel lands at visibly different times), constraints still held to 5e-3 at the steps
+// (measured 3.6e-4; 4e-5 with the build of a001003).
 TEST(ExtremeCases, LooseToleranceRunsWithItsMeasuredError) {
   const RunOutcome r = run(extreme("step_loose_tolerance.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(1);
@@ -95,11 +96,11 @@ TEST(ExtremeCases, LooseToleranceRunsWithItsMeasuredError) {
   RecordProperty("wheel_z_error", sci(e));
   EXPECT_LT(e, 3e-2);
   EXPECT_GT(e, 1e-5);  // it is loose: if this fails the tolerance is not applied
-  EXPECT_LT(step_of(r, "dynamics")["statistics"]["max_position_violation_steps"].get<double>(), 1e-3);
+  EXPECT_LT(step_of(r, "dynamics")["statistics"]["max_position_violation_steps"].get<double>(), 5e-3);
 }
 
 // rtol 1e-12, atol 1e-18 (below rounding; mbdae floors the weights): runs to the end and agrees
-// with rtol 1e-11 to 1e-8 m.
+// with rtol 1e-11 to 1e-8 m (measured 2e-10 m).
 TEST(ExtremeCases, TightToleranceRunsToTheEnd) {
   const RunOutcome r = run(extreme("step_tight_tolerance.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
@@ -140,7 +141,7 @@ TEST(ExtremeCases, StiffTyreX100RunsAccurately) {
 }
 
 // No suspension damping: runs to the end, wheel_z within 1e-4 m of a tighter run (measured
-// 1.2e-5 m), and the wheel
+// 1.0e-5 m), and the wheel
 // still moves at the end (over [1, 1.5] s it travels more than with the spec's damping).
 TEST(ExtremeCases, ZeroDampingRunsAccurately) {
   const RunOutcome r = run(extreme("damping_zero.yaml"));
@@ -166,7 +167,7 @@ TEST(ExtremeCases, ZeroDampingRunsAccurately) {
 // q4 to -1.925 rad and, after a turn through +pi, to 4.35 rad (both 0.004 rad short of the
 // singular configuration at -1.929 = 4.354 - 2 pi): runs to the end and matches the independent
 // reference geometry (carrier-pose formulation, verification/reference) to 1e-9 (measured
-// 1.6e-11 m; the reference's smallest singular value falls from 0.145 at q4_0 to 0.004 there).
+// 1.9e-11 m; the reference's smallest singular value falls from 0.145 at q4_0 to 0.004 there).
 TEST(ExtremeCases, KinematicDriveToTheEndsOfTheTravelMatchesTheReference) {
   const RunOutcome r = run(extreme("kinematics_travel_ends.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
@@ -243,7 +244,7 @@ TEST(ExtremeCases, RoughGuessTenDegreesOffConvergesToTheDesignConfiguration) {
     // axisymmetric): the response agrees with the spec's to the integration tolerance.
     const double e = max_difference(r, spec, "wheel_z");
     RecordProperty(std::string(name) + "_wheel_z_difference", sci(e));
-    EXPECT_LT(e, 2e-6);  // measured 1.9e-7 and 3.6e-7 m: different wheel spin, different steps
+    EXPECT_LT(e, 2e-6);  // measured 2.6e-7 and 2.9e-7 m: different wheel spin, different steps
   }
 }
 

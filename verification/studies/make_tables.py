@@ -106,7 +106,7 @@ def md_escape(s):
 # ------------------------------------------------------------------------------------------------
 
 WP_COLUMNS = ["formulation", "tol", "rtol", "atol", "cpu_median", "cpu_no_output_median", "wall_median", "steps",
-              "rhs_evals", "err_z",
+              "steps_no_output", "rhs_evals", "err_z",
               "err_vz", "err_az", "viol_pos", "viol_vel", "euler_norm_drift", "status"]
 
 
@@ -129,7 +129,7 @@ def work_precision(args):
         parts.append("- Ladder: rtol = tau, atol = %g tau. cpu_median: median over %d run(s) of the integration "
                      "step's `cpu_seconds` (process CPU time, output samples included: projection, "
                      "accelerations and sensors at every sample); cpu_no_output_median: the same runs with "
-                     "samples at t0 and t_end only (identical steps); wall_median: wall time of the whole "
+                     "samples at t0 and t_end only (their step count: steps_no_output); wall_median: wall time of the whole "
                      "scene (assembly and equilibrium included) on a shared machine." % (meta["atol_ratio"],
                                                                                           meta["repeat"]))
         parts.append("- Reference: index3, rtol %g, atol %g: %s, %s steps, %s s CPU. Its check at rtol %g, "

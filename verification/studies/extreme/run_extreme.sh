@@ -5,9 +5,9 @@
 #
 #   verification/studies/extreme/run_extreme.sh [--long] [--only NAME[,NAME...]]
 #
-#   --long   also run the 1000 s cases (poster_1000s_slow_sweep: a few minutes of CPU;
-#            poster_1000s: the spec's sweep continued to 901 Hz, extrapolated to about 18 minutes
-#            of CPU, see docs/extreme-cases.md). Without --long their last stored results are
+#   --long   also run the 1000 s cases (poster_1000s_slow_sweep: about 1.5 minutes of CPU;
+#            poster_1000s, the spec's sweep continued to 901 Hz: about 6 minutes of CPU at commit
+#            910af29, see docs/extreme-cases.md). Without --long their last stored results are
 #            kept in the table.
 #   --only   run only these cases (the table is still rebuilt from every stored result).
 # Environment: BUILD (default build/), OUT (raw run folders, default out/studies/extreme).
