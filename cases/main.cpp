@@ -1,5 +1,5 @@
 // mbdae command-line front end:
-//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--formulation index3|index2-ggl|index1]
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--formulation index3|index2-ggl|index1]
 // Exit codes: 0 success, 1 usage, 2 invalid scene, 3 solve failure.
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +15,7 @@ namespace {
 void usage() {
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
+               "                  [--output-step DT]\n"
                "                  [--formulation index3|index2-ggl|index1]\n"
                "       mbdae check SCENE.yaml\n");
 }
@@ -44,6 +45,13 @@ int main(int argc, char** argv) {
         return 1;
       }
       (a == "--rtol" ? opt.rtol : opt.atol) = v;
+    } else if (a == "--output-step" && i + 1 < argc) {
+      double v;
+      if (!parse_number(argv[++i], v) || !(v > 0)) {
+        std::fprintf(stderr, "mbdae: --output-step expects a positive number of seconds, got '%s'\n", argv[i]);
+        return 1;
+      }
+      opt.output_step = v;
     } else if (a == "--formulation" && i + 1 < argc) {
       opt.formulation = argv[++i];
       if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1") {

@@ -248,22 +248,24 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         io.t1 = step.t_end;
         io.rtol = opt.rtol > 0 ? opt.rtol : step.rtol;
         io.atol = opt.atol > 0 ? opt.atol : step.atol;
-        io.output_step = step.output_step;
+        io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
         io.max_step = step.max_step;
         io.nonlinear_convergence = step.newton_convergence;
         js["newton_convergence"] = io.nonlinear_convergence;
         js["rtol"] = io.rtol;
         js["output_projection"] = step.output_projection;
         js["atol"] = io.atol;
+        js["output_step"] = io.output_step;
         // Index 3 scales its constraint rows like cj^2 M; the GGL and index-1 rows are scaled by
         // KLU's row scaling well enough (measured: no difference), so 1 unless the scene sets one.
         const double scale = step.constraint_scale > 0 ? step.constraint_scale
                              : formulation == "index3" ? automatic_constraint_scale(sys, step) : 1.0;
         js["constraint_scale"] = scale;
         // The integration is the same for every formulation: run it on whichever DAE was made.
-        auto integrate_dae = [&](auto& dae) -> bool {
-        using Dae = std::decay_t<decltype(dae)>;
+        auto integrate_dae = [&](MultibodyDae& dae) -> bool {
         dae.modes = initial_modes(sys, q.data(), step.t0);
+        // A kinematic run reports how close it comes to a singular configuration.
+        dae.track_condition = step.type == AnalysisStep::Type::kKinematics;
           // Output samples solve for accelerations only if a sensor reports one.
           dae.output_accelerations = false;
           for (const auto& s : sys.sensors)
@@ -332,14 +334,11 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         stats["max_position_violation_steps"] = dae.max_position_violation;
         stats["max_position_violation_output_before_projection"] = max_output_violation;
         stats["max_euler_norm_drift"] = dae.max_norm_drift;
-        if constexpr (std::is_base_of_v<MultibodyDae, Dae>)
-          stats["max_velocity_violation_steps"] = dae.max_velocity_violation;
-        if constexpr (std::is_same_v<Dae, Index3Dae>) {
-          if (dae.track_condition) {
-            // Closeness to a singular configuration along a kinematic run.
-            stats["max_constraint_condition"] = dae.max_condition;
-            stats["max_constraint_condition_time"] = dae.max_condition_time;
-          }
+        stats["max_velocity_violation_steps"] = dae.max_velocity_violation;
+        if (dae.track_condition) {
+          // Closeness to a singular configuration along a kinematic run.
+          stats["max_constraint_condition"] = dae.max_condition;
+          stats["max_constraint_condition_time"] = dae.max_condition_time;
         }
         stats["output_rows"] = out.rows.size() ? static_cast<long>(out.rows.size()) : rows;
         js["statistics"] = stats;
@@ -371,7 +370,6 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
           integrated = integrate_dae(dae);
         } else {
           Index3Dae dae(sys, scale);
-          dae.track_condition = step.type == AnalysisStep::Type::kKinematics;
           integrated = integrate_dae(dae);
         }
         if (!integrated) return out;

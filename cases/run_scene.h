@@ -15,6 +15,7 @@ namespace mbdae {
 struct RunOptions {
   std::string out_dir;        // empty: write nothing
   double rtol = 0, atol = 0;  // > 0: override the scene's tolerances
+  double output_step = 0;     // > 0: overrides the dynamics steps' output_step (sample spacing)
   bool progress = true;       // progress line on stderr for runs over a second
   bool keep_rows = false;     // keep results in memory (tests)
   bool verbose = true;        // print assembly / equilibrium results on stdout

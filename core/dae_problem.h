@@ -47,6 +47,8 @@ class DaeProblem {
   // The integrator works on [t_start, t_end] up to the next breakpoint: inputs that jump at
   // t_end must be evaluated with their left limit there.
   virtual void set_segment(double /*t_start*/, double /*t_end*/) {}
+  // Whether output samples need y' (IDA interpolates it at a cost; null is passed if not).
+  virtual bool output_needs_derivative() const { return true; }
   // Called after every accepted step with the step's solution.
   virtual void after_step(double /*t*/, const double* /*y*/) {}
 };

@@ -174,6 +174,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     return o.output_step > 0 ? std::min(o.t1, o.t0 + k * o.output_step) : (k == 0 ? o.t0 : o.t1);
   };
   bool stop_requested = false;
+  const bool with_derivative = problem.output_needs_derivative();
   auto emit_until = [&](double t_reached, bool inclusive) {
     while (!stop_requested && sample_index >= 0) {
       const double ts = sample_time(sample_index);
@@ -181,8 +182,9 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
       // Always from IDA's interpolant (also at a step's own time: the y' IDA returns at a stop
       // time is not the derivative of its position interpolant).
       IDAGetDky(mem, ts, 0, ys);
-      IDAGetDky(mem, ts, 1, yps);
-      if (!output(ts, N_VGetArrayPointer(ys), N_VGetArrayPointer(yps))) stop_requested = true;
+      if (with_derivative) IDAGetDky(mem, ts, 1, yps);
+      if (!output(ts, N_VGetArrayPointer(ys), with_derivative ? N_VGetArrayPointer(yps) : nullptr))
+        stop_requested = true;
       if (ts >= o.t1) { sample_index = -1; break; }
       ++sample_index;
       t_next_sample = sample_time(sample_index);

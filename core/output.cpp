@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +18,7 @@ CsvWriter::~CsvWriter() {
 void CsvWriter::open(const std::string& path, const std::vector<std::string>& columns) {
   path_ = path;
   columns_ = columns.size();
+  line_.assign(32 * columns_ + 2, '\0');
   file_ = std::fopen((path + ".partial").c_str(), "w");
   if (!file_) throw std::runtime_error("cannot write " + path + ".partial");
   for (size_t k = 0; k < columns.size(); ++k)
@@ -25,8 +27,18 @@ void CsvWriter::open(const std::string& path, const std::vector<std::string>& co
 }
 
 void CsvWriter::row(const double* v) {
-  for (size_t k = 0; k < columns_; ++k) std::fprintf(file_, "%s%.15g", k ? "," : "", v[k]);
-  std::fputc('\n', file_);
+  // The same text as printf's %.15g, by std::to_chars (several times faster than fprintf: it
+  // was 8 % of a kinematic sweep's CPU time), one fwrite per row, into a buffer kept for the run.
+  char* p = line_.data();
+  char* const end = line_.data() + line_.size() - 1;
+  for (size_t k = 0; k < columns_; ++k) {
+    if (k) *p++ = ',';
+    const auto r = std::to_chars(p, end, v[k], std::chars_format::general, 15);
+    if (r.ec != std::errc()) break;  // cannot happen: 24 characters per value are reserved
+    p = r.ptr;
+  }
+  *p++ = '\n';
+  std::fwrite(line_.data(), 1, static_cast<size_t>(p - line_.data()), file_);
   ++rows_;
 }
 

@@ -30,6 +30,7 @@ class CsvWriter {
   std::string path_;
   size_t columns_ = 0;
   long rows_ = 0;
+  std::vector<char> line_;  // one row's text
 };
 
 // Writes JSON to path atomically (temporary name, then rename).

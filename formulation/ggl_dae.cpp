@@ -9,72 +9,42 @@ namespace mbdae {
 
 GglDae::GglDae(const System& sys, double constraint_scale, bool velocities_in_error_test)
     : MultibodyDae(sys), scale_(constraint_scale), v_in_test_(velocities_in_error_test) {
-  work_.resize(size());
-  // Record the Jacobian pattern once.
-  std::vector<double> y(size(), 0.0), yp(size(), 0.0);
-  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
-  asm_.begin_pattern(size(), size());
-  assemble(0.0, 1.0, y.data(), yp.data());
-  asm_.finalize();
+  record_pattern();
 }
 
 int GglDae::residual(double t_in, const double* y, const double* yp, double* r) {
   const double t = input_time(t_in);
   const double* q = y;
   const double* v = y + nq_;
-  const double* lambda = y + 2 * nq_;
   const double* mu = y + 2 * nq_ + nc_;
-  // F1 = q' - v + Phi_q^T mu
-  for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
+  // F1 = q' - v + Phi_q^T mu,  F2 = M v' + Phi_q^T lambda - Q
+  kinematic_and_momentum_residual(t, y, yp, r, work_.data());
   add_constraint_forces(sys_, offsets_, q, mu, r);
-  // F2 = M v' + Phi_q^T lambda - Q
-  double* f2 = r + nq_;
-  mass_times(sys_, q, yp + nq_, f2);
-  generalized_forces(sys_, modes, q, v, t, work_.data());
-  for (int i = 0; i < nq_; ++i) f2[i] -= work_[i];
-  add_constraint_forces(sys_, offsets_, q, lambda, f2);
   // F3 = s Phi,  F4 = s (Phi_q v + Phi_t)
   double* f3 = r + 2 * nq_;
   double* f4 = f3 + nc_;
   constraint_values(sys_, offsets_, q, t, f3);
   velocity_constraint_values(sys_, offsets_, q, v, t, f4);
   for (int i = 0; i < 2 * nc_; ++i) f3[i] *= scale_;
-  for (int i = 0; i < size(); ++i)
-    if (!std::isfinite(r[i])) return 1;  // recoverable: IDA retries with a smaller step
-  return 0;
+  return finite_or_retry(r, size());
 }
 
 void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
   const double* q = y;
   const double* v = y + nq_;
-  const double* lambda = y + 2 * nq_;
   const double* mu = y + 2 * nq_ + nc_;
   const int rq = 0, rv = nq_, rp = 2 * nq_, rw = 2 * nq_ + nc_;  // row blocks F1..F4
   const int cq = 0, cv = nq_, cl = 2 * nq_, cm = 2 * nq_ + nc_;  // column blocks q, v, lambda, mu
-  // F1: cj I - I, sum mu_k H_k, Phi_q^T (mu columns).
-  for (int i = 0; i < nq_; ++i) {
-    asm_.add(rq + i, cq + i, cj);
-    asm_.add(rq + i, cv + i, -1.0);
-  }
+  // F1: cj I, -I (shared), sum mu_k H_k, Phi_q^T (mu columns).
+  // F2: cj M, d(M v')/dq and gyroscopic derivatives, -dQ/dq, -dQ/dv, sum lambda_k H_k (shared),
+  // Phi_q^T (lambda columns).
+  assemble_kinematic_and_momentum(t, cj, y, yp, asm_);
   assemble_constraint_hessian(sys_, offsets_, q, mu, rq, cq, asm_);
-  // F2: cj M, d(M v')/dq and gyroscopic derivatives, -dQ/dq, -dQ/dv, sum lambda_k H_k, Phi_q^T.
-  assemble_mass(sys_, q, cj, rv, cv, asm_);
-  assemble_inertia_derivatives(sys_, q, v, yp + nq_, rv, cq, cv, asm_);
-  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, asm_);
-  assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, asm_);
   // F3: s Phi_q (q columns), with Phi_q^T into F1's mu columns.
   assemble_constraint_jacobian(sys_, offsets_, q, scale_, rp, cq, rq, cm, asm_);
   // F4: s Phi_q (v columns), with Phi_q^T into F2's lambda columns; s (H_k v)^T (q columns).
   assemble_constraint_jacobian(sys_, offsets_, q, scale_, rw, cv, rv, cl, asm_);
   assemble_hessian_vector_rows(sys_, offsets_, q, v, scale_, nullptr, 0.0, rw, cq, asm_);
-}
-
-int GglDae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
-  const double t = input_time(t_in);
-  newton_cj_ = cj;
-  asm_.begin_values(values);
-  assemble(t, cj, y, yp);
-  return 0;
 }
 
 void GglDae::error_test_mask(double* id) const {
@@ -87,7 +57,7 @@ void GglDae::error_weights(double h, const double* y, double rtol, double atol, 
   const double av = v_in_test_ ? velocity_atol(h, y, atol) : atol + noise / h;
   const double al = mass_scale_ * (atol + noise / h) / h;
   const double am = (atol + noise) / h;
-  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
+  position_weights(y, rtol, aq, w);
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < 2 * nq_ + nc_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
   for (int i = 2 * nq_ + nc_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + am);

@@ -40,9 +40,7 @@ class GglDae : public MultibodyDae {
                   bool velocities_in_error_test = true);
 
   int size() const override { return 2 * nq_ + 2 * nc_; }
-  const CscPattern& jacobian_pattern() override { return asm_.pattern(); }
   int residual(double t, const double* y, const double* yp, double* r) override;
-  int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
   void error_test_mask(double* id) const override;
   // Newton-test (and error-test) weights. Positions: rtol|q| + atol. Velocities: rtol|v| +
   // atol, plus the rounding floor of the positions amplified by 1/h when v is out of the
@@ -59,11 +57,9 @@ class GglDae : public MultibodyDae {
   bool velocities_error_tested() const override { return v_in_test_; }
 
  private:
-  void assemble(double t, double cj, const double* y, const double* yp);
+  void assemble(double t, double cj, const double* y, const double* yp) override;
   double scale_;
   bool v_in_test_;
-  SparseAssembler asm_;
-  std::vector<double> work_;
 };
 
 }  // namespace mbdae

@@ -10,49 +10,25 @@ namespace mbdae {
 Index1Dae::Index1Dae(const System& sys, double constraint_scale, BaumgarteParameters baumgarte,
                      bool exact_gamma_q)
     : MultibodyDae(sys), scale_(constraint_scale), bg_(baumgarte), exact_gamma_q_(exact_gamma_q) {
-  work_.resize(size());
-  // Record the Jacobian pattern once.
-  std::vector<double> y(size(), 0.0), yp(size(), 0.0);
-  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
-  asm_.begin_pattern(size(), size());
-  assemble(0.0, 1.0, y.data(), yp.data());
-  asm_.finalize();
+  record_pattern();
 }
 
 int Index1Dae::residual(double t_in, const double* y, const double* yp, double* r) {
   const double t = input_time(t_in);
-  const double* q = y;
-  const double* v = y + nq_;
-  const double* lambda = y + 2 * nq_;
-  for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
-  double* f2 = r + nq_;
-  mass_times(sys_, q, yp + nq_, f2);
-  generalized_forces(sys_, modes, q, v, t, work_.data());
-  for (int i = 0; i < nq_; ++i) f2[i] -= work_[i];
-  add_constraint_forces(sys_, offsets_, q, lambda, f2);
+  kinematic_and_momentum_residual(t, y, yp, r, work_.data());
   double* f3 = r + 2 * nq_;
-  stabilized_acceleration_constraints(sys_, offsets_, q, v, yp + nq_, t, bg_.alpha, bg_.beta, f3);
+  stabilized_acceleration_constraints(sys_, offsets_, y, y + nq_, yp + nq_, t, bg_.alpha, bg_.beta, f3);
   for (int i = 0; i < nc_; ++i) f3[i] *= scale_;
-  for (int i = 0; i < size(); ++i)
-    if (!std::isfinite(r[i])) return 1;  // recoverable: IDA retries with a smaller step
-  return 0;
+  return finite_or_retry(r, size());
 }
 
 void Index1Dae::assemble(double t, double cj, const double* y, const double* yp) {
   const double* q = y;
   const double* v = y + nq_;
-  const double* lambda = y + 2 * nq_;
   const double* acc = yp + nq_;
-  const int rq = 0, rv = nq_, ra = 2 * nq_;  // row blocks F1, F2, F3
+  const int rv = nq_, ra = 2 * nq_;  // row blocks F2, F3
   const int cq = 0, cv = nq_, cl = 2 * nq_;  // column blocks q, v, lambda
-  for (int i = 0; i < nq_; ++i) {
-    asm_.add(rq + i, cq + i, cj);
-    asm_.add(rq + i, cv + i, -1.0);
-  }
-  assemble_mass(sys_, q, cj, rv, cv, asm_);
-  assemble_inertia_derivatives(sys_, q, v, acc, rv, cq, cv, asm_);
-  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, asm_);
-  assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, asm_);
+  assemble_kinematic_and_momentum(t, cj, y, yp, asm_);
   // F3, q columns: s [beta^2 Phi_q + (H_k v')^T + 2 alpha (H_k v)^T (+ d(v^T H_k v)/dq)],
   // with Phi_q^T into F2's lambda columns.
   const double a = bg_.alpha, b2 = bg_.beta * bg_.beta;
@@ -65,14 +41,6 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
   assemble_hessian_vector_rows(sys_, offsets_, q, v, 2.0 * scale_, nullptr, 0.0, ra, cv, asm_);
 }
 
-int Index1Dae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
-  const double t = input_time(t_in);
-  newton_cj_ = cj;
-  asm_.begin_values(values);
-  assemble(t, cj, y, yp);
-  return 0;
-}
-
 void Index1Dae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < 2 * nq_ ? 1.0 : 0.0;
 }
@@ -81,7 +49,7 @@ void Index1Dae::error_weights(double h, const double* y, double rtol, double ato
   const double noise = position_noise(y);
   const double al = mass_scale_ * (atol + noise) / h;
   const double aq = position_atol(y, atol), av = velocity_atol(h, y, atol);
-  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
+  position_weights(y, rtol, aq, w);
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }

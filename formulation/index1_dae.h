@@ -57,9 +57,7 @@ class Index1Dae : public MultibodyDae {
                      BaumgarteParameters baumgarte = {}, bool exact_gamma_q = false);
 
   int size() const override { return 2 * nq_ + nc_; }
-  const CscPattern& jacobian_pattern() override { return asm_.pattern(); }
   int residual(double t, const double* y, const double* yp, double* r) override;
-  int jacobian(double t, double cj, const double* y, const double* yp, double* values) override;
   void error_test_mask(double* id) const override;
   // Positions rtol|q| + atol, velocities rtol|v| + atol (atol floored at ten roundings of the
   // largest |q|, |v|); the index-1 multipliers follow the accelerations, whose error is that
@@ -74,12 +72,10 @@ class Index1Dae : public MultibodyDae {
   const BaumgarteParameters& baumgarte() const { return bg_; }
 
  private:
-  void assemble(double t, double cj, const double* y, const double* yp);
+  void assemble(double t, double cj, const double* y, const double* yp) override;
   double scale_;
   BaumgarteParameters bg_;
   bool exact_gamma_q_;
-  SparseAssembler asm_;
-  std::vector<double> work_;
 };
 
 }  // namespace mbdae

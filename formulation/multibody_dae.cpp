@@ -24,6 +24,58 @@ std::string MultibodyDae::constraint_label(int row) const {
   return "row " + std::to_string(row);
 }
 
+void MultibodyDae::record_pattern() {
+  work_.resize(size());
+  std::vector<double> y(size(), 0.0), yp(size(), 0.0);
+  std::copy(sys_.q0.begin(), sys_.q0.end(), y.begin());
+  asm_.begin_pattern(size(), size());
+  assemble(0.0, 1.0, y.data(), yp.data());
+  asm_.finalize();
+}
+
+int MultibodyDae::jacobian(double t_in, double cj, const double* y, const double* yp, double* values) {
+  newton_cj_ = cj;
+  asm_.begin_values(values);
+  assemble(input_time(t_in), cj, y, yp);
+  return 0;
+}
+
+void MultibodyDae::kinematic_and_momentum_residual(double t, const double* y, const double* yp,
+                                                   double* r, double* force_work) const {
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
+  double* f2 = r + nq_;
+  mass_times(sys_, q, yp + nq_, f2);
+  generalized_forces(sys_, modes, q, v, t, force_work);
+  for (int i = 0; i < nq_; ++i) f2[i] -= force_work[i];
+  add_constraint_forces(sys_, offsets_, q, lambda, f2);
+}
+
+void MultibodyDae::assemble_kinematic_and_momentum(double t, double cj, const double* y,
+                                                   const double* yp, SparseAssembler& a) const {
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  const int rq = 0, rv = nq_;  // row blocks F1, F2
+  const int cq = 0, cv = nq_;  // column blocks q, v
+  for (int i = 0; i < nq_; ++i) {
+    a.add(rq + i, cq + i, cj);
+    a.add(rq + i, cv + i, -1.0);
+  }
+  assemble_mass(sys_, q, cj, rv, cv, a);
+  assemble_inertia_derivatives(sys_, q, v, yp + nq_, rv, cq, cv, a);
+  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, a);
+  assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, a);
+}
+
+int MultibodyDae::finite_or_retry(const double* r, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(r[i])) return 1;
+  return 0;
+}
+
 std::string MultibodyDae::component_name(int i) const {
   static const char* names[7] = {"x", "y", "z", "e0", "e1", "e2", "e3"};
   if (i < 2 * nq_) {
@@ -52,6 +104,10 @@ double MultibodyDae::velocity_atol(double h, const double* y, double atol) const
   for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
   const double step = newton_cj_ > 0 ? 1.0 / newton_cj_ : h;
   return std::fmax(atol, 10 * 2.22e-16 * std::fmax(vmax, qmax / step));
+}
+
+void MultibodyDae::position_weights(const double* y, double rtol, double aq, double* w) const {
+  for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
 }
 
 void MultibodyDae::switches(double t_in, const double* y, double* g) {
@@ -125,7 +181,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
                                        std::vector<double>& a, bool project) {
   const double t = input_time(t_in);
   q.assign(y, y + nq_);
-  if (velocities_error_tested())
+  if (output_velocities_from_state())
     v.assign(y + nq_, y + 2 * nq_);
   else
     v.assign(yp, yp + nq_);
@@ -135,6 +191,14 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
   // the accelerations of the state (more accurate than interpolated ones).
   constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
   const double violation = max_abs(out_phi_.data(), nc_);
+  // The condition estimate costs a factorization: every tenth sample is enough to see it grow.
+  if (track_condition && (condition_samples_++ % 10) == 0) {
+    const double c = aug_.constraint_condition(q.data());
+    if (c > max_condition) {
+      max_condition = c;
+      max_condition_time = t;
+    }
+  }
   if (project) {
     if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
     velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
