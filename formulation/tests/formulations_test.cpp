@@ -23,39 +23,20 @@
 #include "formulation/mechanics.h"
 #include "formulation/system.h"
 #include "formulation/tests/test_models.h"
+#include "formulation/tests/pendulum_reference.h"
 
 namespace mbdae {
 namespace {
+
+using mbdae::testing::downward_crossings;
+using mbdae::testing::elliptic_k;
 
 constexpr double kPi = 3.14159265358979323846;
 
 // --- a. Newton matrices ------------------------------------------------------------------------
 
-struct State {
-  std::vector<double> q, v, a, lambda, mu;
-};
-
-// A state off the constraint manifold (the Newton matrix must be right everywhere).
-State random_state(const System& sys, unsigned seed) {
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  State s;
-  const int nq = sys.nq(), nc = sys.num_constraint_rows();
-  s.q = sys.q0;
-  for (int i = 0; i < nq; ++i) s.q[i] += 0.05 * u(gen);
-  for (int b = 0; b < sys.num_bodies(); ++b) Eigen::Map<Vec4>(s.q.data() + 7 * b + 3).normalize();
-  s.v.resize(nq);
-  s.a.resize(nq);
-  for (int i = 0; i < nq; ++i) {
-    s.v[i] = u(gen);
-    s.a[i] = u(gen);
-  }
-  s.lambda.resize(nc);
-  s.mu.resize(nc);
-  for (auto& l : s.lambda) l = 10 * u(gen);
-  for (auto& m : s.mu) m = 0.1 * u(gen);
-  return s;
-}
+using testing::random_state;
+using State = testing::RandomState;
 
 Eigen::MatrixXd analytic_matrix(DaeProblem& dae, double t, double cj, const std::vector<double>& y,
                                 const std::vector<double>& yp) {
@@ -182,38 +163,6 @@ TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
 }
 
 // --- b. Compound pendulum ------------------------------------------------------------------------
-
-double agm(double a, double b) {
-  for (int i = 0; i < 64 && std::fabs(a - b) > 1e-16 * a; ++i) {
-    const double m = 0.5 * (a + b);
-    b = std::sqrt(a * b);
-    a = m;
-  }
-  return 0.5 * (a + b);
-}
-double elliptic_k(double k) { return kPi / (2.0 * agm(1.0, std::sqrt(1.0 - k * k))); }
-
-// Downward zero crossings of u from samples (t, u, u'), cubic Hermite on each bracket.
-std::vector<double> downward_crossings(const std::vector<double>& t, const std::vector<double>& u,
-                                       const std::vector<double>& du) {
-  std::vector<double> out;
-  for (size_t i = 0; i + 1 < t.size(); ++i) {
-    if (!(u[i] > 0 && u[i + 1] <= 0)) continue;
-    const double h = t[i + 1] - t[i];
-    auto p = [&](double s) {
-      const double s2 = s * s, s3 = s2 * s;
-      return (2 * s3 - 3 * s2 + 1) * u[i] + (s3 - 2 * s2 + s) * h * du[i] +
-             (-2 * s3 + 3 * s2) * u[i + 1] + (s3 - s2) * h * du[i + 1];
-    };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 80; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (p(mid) > 0 ? lo : hi) = mid;
-    }
-    out.push_back(t[i] + 0.5 * (lo + hi) * h);
-  }
-  return out;
-}
 
 // A formulation that also records, per third of the run, the largest |Phi| and |Phi_q v + Phi_t|
 // of the integrator's accepted steps.

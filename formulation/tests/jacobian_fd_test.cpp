@@ -19,27 +19,8 @@ using testing::make_joint;
 
 using testing::all_types_model;
 
-struct RandomState {
-  std::vector<double> q, v, a, lambda;
-};
-RandomState random_state(const System& sys, unsigned seed) {
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  RandomState s;
-  const int nq = sys.nq();
-  s.q = sys.q0;
-  for (int i = 0; i < nq; ++i) s.q[i] += 0.05 * u(gen);
-  for (int b = 0; b < sys.num_bodies(); ++b) Eigen::Map<Vec4>(s.q.data() + 7 * b + 3).normalize();
-  s.v.resize(nq);
-  s.a.resize(nq);
-  for (int i = 0; i < nq; ++i) {
-    s.v[i] = u(gen);
-    s.a[i] = u(gen);
-  }
-  s.lambda.resize(sys.num_constraint_rows());
-  for (auto& l : s.lambda) l = 10 * u(gen);
-  return s;
-}
+using testing::random_state;
+using testing::RandomState;
 
 TEST(JacobianFd, ConstraintGradientsAndHessians) {
   const System sys = build_system(all_types_model());

@@ -1,7 +1,11 @@
 // Small models shared by the formulation tests, built in code (no scene files).
 #pragma once
 
+#include <random>
+#include <vector>
+
 #include "formulation/model.h"
+#include "formulation/system.h"
 
 namespace mbdae::testing {
 
@@ -148,6 +152,33 @@ inline Model all_types_model() {
   s2.body2 = "d";
   m.forces.push_back(s2);
   return m;
+}
+
+// A state off the constraint manifold (Newton matrices and derivatives must be right
+// everywhere): q0 moved by up to 0.05 per coordinate (Euler parameters renormalized), v and a
+// in [-1, 1], multipliers lambda in [-10, 10] and mu in [-0.1, 0.1].
+struct RandomState {
+  std::vector<double> q, v, a, lambda, mu;
+};
+inline RandomState random_state(const System& sys, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  RandomState s;
+  const int nq = sys.nq(), nc = sys.num_constraint_rows();
+  s.q = sys.q0;
+  for (int i = 0; i < nq; ++i) s.q[i] += 0.05 * u(gen);
+  for (int b = 0; b < sys.num_bodies(); ++b) Eigen::Map<Vec4>(s.q.data() + 7 * b + 3).normalize();
+  s.v.resize(nq);
+  s.a.resize(nq);
+  for (int i = 0; i < nq; ++i) {
+    s.v[i] = u(gen);
+    s.a[i] = u(gen);
+  }
+  s.lambda.resize(nc);
+  s.mu.resize(nc);
+  for (auto& l : s.lambda) l = 10 * u(gen);
+  for (auto& m : s.mu) m = 0.1 * u(gen);
+  return s;
 }
 
 }  // namespace mbdae::testing
