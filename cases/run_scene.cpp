@@ -6,6 +6,7 @@
 #include <iostream>
 #include <type_traits>
 
+#include "cases/failure_diagnosis.h"
 #include "core/errors.h"
 #include "core/ida_driver.h"
 #include "core/output.h"
@@ -357,7 +358,21 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
                       js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
                       st.event_times.size(), st.cpu_seconds, dae.max_position_violation);
         if (!st.ok) {
-          fail(st.status, st.message, js);
+          // The last configuration reached and, if the constraint Jacobian is singular there,
+          // why the run cannot go on (a drive past the mechanism's travel, a dead centre).
+          std::string message = st.message;
+          if (st.status == "integration_failed") {
+            AugmentedSolver probe(sys);
+            const FailureDiagnosis d = diagnose_integration_failure(
+                sys, dae.modes, column_sensors, q.data(), y.data() + sys.nq(), st.t_reached,
+                dae.input_time(st.t_reached), probe.constraint_condition(q.data()), st.message);
+            for (const auto& [key, value] : d.details.items()) js[key] = value;
+            if (d.singular) {
+              js["solver_message"] = st.message;
+              message = d.message;
+            }
+          }
+          fail(st.status, message, js);
           return false;
         }
         return true;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/SVD>
+
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "verification/reference/suspension_reference.h"
@@ -230,23 +232,111 @@ TEST(ExtremeCases, KinematicDriveToTheEndsRunsAtRtol1e13) {
   EXPECT_LT(k["statistics"]["max_position_violation_steps"].get<double>(), 1e-11);
 }
 
-// q4 driven to -2.5 rad: the run stops where the travel ends (q4 = -1.929 rad, t = 0.789 s) with
-// exit code 3 and a message naming the time; the rows written before are finite and on the
-// constraints.
-TEST(ExtremeCases, KinematicDrivePastTheTravelFailsCleanlyNamingTheTime) {
+// The end of rod 2's travel from the independent reference geometry: the fold q4* where the
+// carrier-pose Jacobian becomes singular, by bisection on the branch continued from the design
+// pose: a bisection point counts as reached if the continuation converges from the last reached
+// pose with the wheel centre moving at most 0.5 sqrt(|dq4|) m and the smallest singular value
+// decreasing (past the fold Newton finds nothing or jumps to another branch, 2 to 8 cm away).
+struct ReferenceFold {
+  double q4 = 0;               // the last reached q4 (within 1e-12 of the fold)
+  ref::CarrierPose pose;       // there
+  double sigma_min = 0;
+};
+ReferenceFold reference_fold() {
+  const ref::SuspensionData data = ref::spec_data();
+  ref::NewtonReport rep;
+  ReferenceFold f;
+  f.q4 = -1.928;  // 1.1e-3 rad short of the fold (from a scan of the reference in q4)
+  f.pose = ref::continue_pose(data, ref::design_pose(data), data.q4_design, f.q4, &rep, 0.01);
+  EXPECT_TRUE(rep.converged);
+  f.sigma_min = rep.min_singular_value;
+  double lo = -1.931;
+  while (f.q4 - lo > 1e-12) {
+    const double mid = 0.5 * (lo + f.q4);
+    ref::NewtonReport r;
+    const ref::CarrierPose p = ref::continue_pose(data, f.pose, f.q4, mid, &r, 0.25 * (f.q4 - mid));
+    const double moved = (ref::wheel_outputs(data, p).centre - ref::wheel_outputs(data, f.pose).centre).norm();
+    if (r.converged && r.min_singular_value < f.sigma_min && moved <= 0.5 * std::sqrt(f.q4 - mid)) {
+      f.q4 = mid;
+      f.pose = p;
+      f.sigma_min = r.min_singular_value;
+    } else {
+      lo = mid;
+    }
+  }
+  return f;
+}
+
+// q4 driven to -2.5 rad: the run stops where the travel ends, with exit code 3 and a message
+// that says so: the drive's value it cannot reach, the singular constraint Jacobian, the joints
+// that lose rank, the last configuration. Checked against the reference geometry: the fold q4*
+// (the last q4 is within 1e-5 rad of it and not beyond), the wheel centre there, and the joints:
+// the reference's left singular vector at the fold (one weight per rod equation and the drive)
+// names rods 1 and 3 as carrying the singular combination and rods 4 and 5 as the least involved;
+// the message must name rod 1's and rod 3's joints and none of rod 4's and rod 5's.
+TEST(ExtremeCases, KinematicDrivePastTheTravelNamesTheSingularConfiguration) {
   const RunOutcome r = run(extreme("kinematics_past_travel.yaml"));
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.summary["status"], "integration_failed");
   const std::string msg = r.summary.value("message", "");
-  EXPECT_NE(msg.find("t = 0.789"), std::string::npos) << msg;
   const json& k = step_of(r, "kinematics");
-  EXPECT_NEAR(k["t_reached"].get<double>(), 0.789, 2e-3);
+  const double t_fail = k["t_reached"].get<double>();
   EXPECT_LT(k["statistics"]["max_position_violation_steps"].get<double>(), 1e-9);
   ASSERT_FALSE(r.rows.empty());
   EXPECT_TRUE(all_finite(r));
-  const double q4_last = r.rows.back()[column(r, "q4")];
-  EXPECT_GT(q4_last, -1.93);
-  EXPECT_LT(q4_last, -1.92);
+
+  // The last configuration: q4 follows the drive's formula up to the failure, and the fold of the
+  // reference geometry is just beyond it.
+  const ref::SuspensionData data = ref::spec_data();
+  const double q4_last = k["last_configuration"]["drives"]["q4"]["reached"].get<double>();
+  EXPECT_NEAR(q4_last, data.q4_design + (-2.5 - data.q4_design) * t_fail, 1e-9);
+  const ReferenceFold fold = reference_fold();
+  RecordProperty("reference_fold_q4", sci(fold.q4));
+  RecordProperty("last_q4_minus_fold", sci(q4_last - fold.q4));
+  EXPECT_GT(q4_last, fold.q4 - 1e-9);
+  EXPECT_LT(q4_last - fold.q4, 1e-5);
+  ref::NewtonReport rep;
+  const ref::CarrierPose at_last = ref::continue_pose(data, ref::design_pose(data), data.q4_design, q4_last, &rep, 0.01);
+  ASSERT_TRUE(rep.converged);
+  const double z_last = k["last_configuration"]["sensors"]["wheel_z"].get<double>();
+  EXPECT_NEAR(z_last, ref::wheel_outputs(data, at_last).centre.z(), 1e-7);
+
+  // The message.
+  char q4_text[32], z_text[32];
+  std::snprintf(q4_text, sizeof q4_text, "q4 = %.6f", q4_last);
+  std::snprintf(z_text, sizeof z_text, "wheel_z = %.6f", z_last);
+  EXPECT_NE(msg.find("the mechanism cannot reach q4 = "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("at t = " + std::to_string(t_fail).substr(0, 6)), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the constraint Jacobian becomes singular (condition estimate"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(std::string(q4_text).substr(0, 12)), std::string::npos) << msg;
+  EXPECT_NE(msg.find(std::string(z_text).substr(0, 15)), std::string::npos) << msg;
+  const json& cj = k["constraint_jacobian"];
+  EXPECT_TRUE(cj["singular"].get<bool>());
+  const double ratio = cj["smallest_singular_value"].get<double>() / cj["largest_singular_value"].get<double>();
+  RecordProperty("singular_value_ratio", sci(ratio));
+  RecordProperty("condition_estimate", sci(cj["condition_estimate"].get<double>()));
+  EXPECT_LT(ratio, 1e-4);
+
+  // Which rods: the reference's left singular vector (row-normalized pose Jacobian; equation 0 is
+  // rod 5, 1..4 the ball cuts of rods 1..4, 5 the drive).
+  ref::Matrix6 jn = ref::pose_jacobian(data, fold.pose);
+  for (int i = 0; i < 6; ++i) jn.row(i) /= jn.row(i).norm();
+  const Eigen::JacobiSVD<ref::Matrix6> svd(jn, Eigen::ComputeFullU);
+  const ref::Vector6 y = svd.matrixU().col(5).cwiseAbs();
+  std::vector<int> rods = {1, 2, 3, 4, 5};
+  auto rod_weight = [&](int rod) { return y(rod == 5 ? 0 : rod); };
+  std::sort(rods.begin(), rods.end(), [&](int a, int b) { return rod_weight(a) > rod_weight(b); });
+  std::string order;
+  for (int rod : rods) order += " rod" + std::to_string(rod) + " " + sci(rod_weight(rod));
+  RecordProperty("reference_rod_weights", order);
+  const std::string named = msg.substr(0, msg.find("(largest weights first"));
+  auto names_rod = [&](int rod) {
+    const std::string mount = "joint rod" + std::to_string(rod) + "_mount";
+    const std::string other = rod == 5 ? "joint carrier_ball" : "cut ball" + std::to_string(rod);
+    return named.find(mount) != std::string::npos || named.find(other) != std::string::npos;
+  };
+  for (int i = 0; i < 2; ++i) EXPECT_TRUE(names_rod(rods[i])) << "rod" << rods[i] << " not named:" << order << "\n" << msg;
+  for (int i = 3; i < 5; ++i) EXPECT_FALSE(names_rod(rods[i])) << "rod" << rods[i] << " named:" << order << "\n" << msg;
 }
 
 // --- Rough initial guess ----------------------------------------------------------------------------
