@@ -302,6 +302,21 @@ TEST(SceneValidation, NegativeMaxStep) {
   expect_one(t, line_of(t, "max_step"), "max_step", "must not be negative");
 }
 
+TEST(SceneValidation, UnknownAssemblyModeCheck) {
+  const std::string t = with("{type: assembly}", "{type: assembly, mode_check: warning}");
+  expect_one(t, line_of(t, "mode_check"), "mode_check", "expected warn, fail or off, got 'warning'");
+}
+
+TEST(SceneValidation, AssemblyModeCheckAngleOutOfRange) {
+  const std::string t = with("{type: assembly}", "{type: assembly, mode_check_deg: 0}");
+  expect_one(t, line_of(t, "mode_check_deg"), "mode_check_deg", "out of range (0, 180]");
+}
+
+TEST(SceneValidation, ModeCheckOnlyForAssembly) {
+  const std::string t = with("atol: 1.0e-8", "atol: 1.0e-8, mode_check: fail");
+  expect_one(t, line_of(t, "mode_check"), "mode_check", "does not apply to");
+}
+
 // ---- References ------------------------------------------------------------------------------
 
 TEST(SceneValidation, UnknownParentBody) {

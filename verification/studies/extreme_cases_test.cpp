@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -352,6 +354,8 @@ TEST(ExtremeCases, RoughGuessTenDegreesOffConvergesToTheDesignConfiguration) {
     const RunOutcome r = run(extreme(name));
     ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
     const json& a = step_of(r, "assembly");
+    EXPECT_TRUE(a["assembly_mode"]["same_as_guess"].get<bool>()) << a["assembly_mode"].dump();
+    EXPECT_FALSE(r.summary.contains("warnings")) << r.summary["warnings"].dump();
     EXPECT_LE(a["max_constraint_violation"].get<double>(), 1e-12);
     EXPECT_LE(a["iterations"].get<int>(), 10);
     for (const char* s : {"wheel_x", "wheel_y", "wheel_z", "camber", "toe"})
@@ -366,6 +370,63 @@ TEST(ExtremeCases, RoughGuessTenDegreesOffConvergesToTheDesignConfiguration) {
     RecordProperty(std::string(name) + "_wheel_z_difference", sci(e));
     EXPECT_LT(e, 2e-6);  // measured 2.6e-7 and 2.9e-7 m: different wheel spin, different steps
   }
+}
+
+// 60 degrees above: the assembly converges (to rounding) at the same q4 as the design
+// configuration, but elsewhere: another assembly mode of the linkage (checked here against the
+// spec scene's assembly: the wheel centre is more than 0.1 m away, the toe differs by more than
+// 0.1 rad). The run says so: a warning in summary.json naming exactly the free joint angles whose
+// converged value is more than 90 degrees (wrapped) from the scene's guess, computed here from the
+// scene's guesses and the converged coordinates. With mode_check: fail the same scene stops
+// with exit code 3.
+TEST(ExtremeCases, RoughGuessSixtyDegreesOffWarnsOfAnotherAssemblyMode) {
+  const RunOutcome spec = run(spec_scene("dynamics_step.yaml"));
+  ASSERT_EQ(spec.exit_code, 0);
+  const json& sa = step_of(spec, "assembly");
+  const std::string path = extreme("rough_guess_60deg_plus.yaml");
+  const RunOutcome r = run(path);
+  ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
+  const json& a = step_of(r, "assembly");
+  EXPECT_LE(a["max_constraint_violation"].get<double>(), 1e-12);
+  EXPECT_NEAR(a["coordinates"]["q4"].get<double>(), sa["coordinates"]["q4"].get<double>(), 1e-12);
+  double distance = 0;
+  for (const char* s : {"wheel_x", "wheel_y", "wheel_z"})
+    distance = std::hypot(distance, a["sensors"][s].get<double>() - sa["sensors"][s].get<double>());
+  RecordProperty("wheel_centre_distance_to_design", sci(distance));
+  EXPECT_GT(distance, 0.1);
+  EXPECT_GT(std::fabs(a["sensors"]["toe"].get<double>() - sa["sensors"]["toe"].get<double>()), 0.1);
+
+  // The coordinates more than 90 degrees from the scene's guess.
+  const Scene scene = load_scene(path);
+  std::vector<std::string> far;
+  for (const auto& [name, spec_c] : scene.model.coordinates) {
+    if (name == "q1" || name == "q4" || !a["coordinates"].contains(name)) continue;  // locked, held
+    if (spec_c.mode != CoordinateSpec::Mode::kFree) continue;
+    const double change = std::remainder(a["coordinates"][name].get<double>() - spec_c.initial, 2 * M_PI);
+    if (std::fabs(change) > M_PI / 2) far.push_back(name);
+  }
+  ASSERT_FALSE(far.empty());
+  ASSERT_TRUE(r.summary.contains("warnings"));
+  const std::string warning = r.summary["warnings"][0].get<std::string>();
+  EXPECT_NE(warning.find("assembly converged to a different assembly mode"), std::string::npos) << warning;
+  const json& moved = a["assembly_mode"]["far_from_guess"];
+  EXPECT_EQ(moved.size(), far.size()) << moved.dump();
+  for (const auto& name : far) EXPECT_NE(warning.find(name + " "), std::string::npos) << name << ": " << warning;
+
+  // Policy fail.
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "{type: assembly, hold: [q4]}";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "{type: assembly, hold: [q4], mode_check: fail}");
+  RunOptions o;
+  o.verbose = false;
+  o.progress = false;
+  const RunOutcome failed = run_scene(load_scene_text(text, path), o);
+  EXPECT_EQ(failed.exit_code, 3);
+  EXPECT_EQ(failed.summary["status"], "assembly_mode_changed");
+  const std::string same = warning.substr(0, warning.find("; check the guess"));
+  EXPECT_EQ(failed.summary["message"].get<std::string>().substr(0, same.size()), same);
 }
 
 // 90 degrees below: the assembly does not converge and says so (exit 3, most violated equations).
