@@ -210,7 +210,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
             char limit[32];
             std::snprintf(limit, sizeof limit, "%g", step.mode_check_deg);
             const std::string message =
-                "assembly converged to a different assembly mode: coordinate" +
+                "assembly converged far from the guess, probably to another assembly mode: coordinate" +
                 std::string(moved.size() > 1 ? "s " : " ") + names.str() + " moved by more than " + limit +
                 " degrees from the guess (" + detail.str() + "); check the guess (mode_check: " + step.mode_check + ")";
             if (step.mode_check == "fail") {
