@@ -669,6 +669,24 @@ TEST_F(Executable, MissingFileExitsTwo) {
   EXPECT_NE(r.output.find("cannot read the file"), std::string::npos) << r.output;
 }
 
+// The diagnosis of a drive past the mechanism's travel and the assembly-mode warning reach the
+// command line (docs/extreme-cases.md): on stderr, the same text as summary.json's.
+TEST_F(Executable, DrivePastTheTravelSaysWhyOnStderr) {
+  const std::string scene = std::string(MBDAE_SOURCE_DIR) + "/verification/studies/extreme/kinematics_past_travel.yaml";
+  const CliResult r = run("run '" + scene + "' --out '" + (dir / "out").string() + "'");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("mbdae: the mechanism cannot reach q4 = -1.9291"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the constraint Jacobian becomes singular"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("last reached configuration"), std::string::npos) << r.output;
+}
+
+TEST_F(Executable, AssemblyModeWarningOnStderrAlsoWhenQuiet) {
+  const std::string scene = std::string(MBDAE_SOURCE_DIR) + "/verification/studies/extreme/rough_guess_60deg_plus.yaml";
+  const CliResult r = run("run '" + scene + "' --out '" + (dir / "out").string() + "' --quiet");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("mbdae: warning: assembly converged far from the guess"), std::string::npos) << r.output;
+}
+
 TEST_F(Executable, UsageErrorExitsOne) {
   EXPECT_EQ(run("").code, 1);
   EXPECT_EQ(run("run '" + write(kValid) + "'").code, 1);  // no --out
