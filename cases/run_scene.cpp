@@ -4,12 +4,15 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <sstream>
 #include <type_traits>
 
+#include "cases/failure_diagnosis.h"
 #include "core/errors.h"
 #include "core/ida_driver.h"
 #include "core/output.h"
 #include "formulation/analyses.h"
+#include "formulation/assembly_mode.h"
 #include "formulation/ggl_dae.h"
 #include "formulation/index1_dae.h"
 #include "formulation/index3_dae.h"
@@ -93,7 +96,9 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
   summary["model"] = scene.model.name;
   summary["status"] = "running";
   json steps = json::array();
+  json warnings = json::array();
   auto write_summary = [&] {
+    if (!warnings.empty()) summary["warnings"] = warnings;
     summary["steps"] = steps;
     if (!opt.out_dir.empty()) write_json_file(opt.out_dir + "/summary.json", summary);
   };
@@ -181,6 +186,42 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
           return out;
         }
         js["sensors"] = sensors_json(sys, initial_modes(sys, q.data(), step.t0), q.data(), step.t0);
+        if (step.mode_check != "off") {
+          // Another assembly mode? (formulation/assembly_mode.h)
+          const std::vector<CoordinateMove> moved =
+              coordinates_far_from_guess(sys, q.data(), held, step.mode_check_deg * M_PI / 180.0);
+          json list = json::array();
+          std::ostringstream names, detail;
+          for (size_t i = 0; i < moved.size(); ++i) {
+            const CoordinateMove& m = moved[i];
+            list.push_back({{"coordinate", m.name}, {"guess_deg", m.guess * 180 / M_PI},
+                            {"converged_deg", m.converged * 180 / M_PI}, {"change_deg", m.change * 180 / M_PI}});
+            names << (i ? ", " : "") << m.name;
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "%s%s %.1f -> %.1f deg", i ? ", " : "", m.name.c_str(),
+                          m.guess * 180 / M_PI, m.converged * 180 / M_PI);
+            detail << buf;
+          }
+          js["assembly_mode"] = {{"policy", step.mode_check},
+                                 {"limit_deg", step.mode_check_deg},
+                                 {"same_as_guess", moved.empty()},
+                                 {"far_from_guess", list}};
+          if (!moved.empty()) {
+            char limit[32];
+            std::snprintf(limit, sizeof limit, "%g", step.mode_check_deg);
+            const std::string message =
+                "assembly converged far from the guess, probably to another assembly mode: coordinate" +
+                std::string(moved.size() > 1 ? "s " : " ") + names.str() + " moved by more than " + limit +
+                " degrees from the guess (" + detail.str() + "); check the guess (mode_check: " + step.mode_check + ")";
+            if (step.mode_check == "fail") {
+              fail("assembly_mode_changed", message, js);
+              return out;
+            }
+            js["warnings"] = json::array({message});
+            warnings.push_back(message);
+            std::fprintf(stderr, "mbdae: warning: %s\n", message.c_str());
+          }
+        }
         js["status"] = "ok";
         if (opt.verbose) {
           std::printf("assembly: converged in %d iterations, max constraint violation %.3g\n", r.iterations, r.residual);
@@ -356,7 +397,21 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
                       js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
                       st.event_times.size(), st.cpu_seconds, dae.max_position_violation);
         if (!st.ok) {
-          fail(st.status, st.message, js);
+          // The last configuration reached and, if the constraint Jacobian is singular there,
+          // why the run cannot go on (a drive past the mechanism's travel, a dead centre).
+          std::string message = st.message;
+          if (st.status == "integration_failed") {
+            AugmentedSolver probe(sys);
+            const FailureDiagnosis d = diagnose_integration_failure(
+                sys, dae.modes, column_sensors, q.data(), y.data() + sys.nq(), st.t_reached,
+                dae.input_time(st.t_reached), probe.constraint_condition(q.data()), st.message);
+            for (const auto& [key, value] : d.details.items()) js[key] = value;
+            if (d.singular) {
+              js["solver_message"] = st.message;
+              message = d.message;
+            }
+          }
+          fail(st.status, message, js);
           return false;
         }
         return true;

@@ -22,6 +22,10 @@ struct AnalysisStep {
   // Report the largest change of these sensors before this time ("nothing moves before").
   double quiet_until = -1;
   std::vector<std::string> quiet_sensors;
+  // Assembly: what to do when a free rotational coordinate ends more than mode_check_deg from its
+  // guess (formulation/assembly_mode.h): "warn" (summary and stderr), "fail" (exit 3) or "off".
+  std::string mode_check = "warn";
+  double mode_check_deg = 90;
   SourceLocation where;
 };
 

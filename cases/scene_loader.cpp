@@ -669,7 +669,7 @@ struct Loader {
     s.where = where(n);
     static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
                                    "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "newton_convergence", "output_projection",
-                                   "quiet_until", "quiet_sensors"};
+                                   "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg"};
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
     if (type == "assembly") s.type = AnalysisStep::Type::kAssembly;
@@ -678,7 +678,7 @@ struct Loader {
     else if (type == "dynamics") s.type = AnalysisStep::Type::kDynamics;
     else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (assembly, equilibrium, kinematics, dynamics)");
     const bool integrates = s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics;
-    if (type == "assembly") applies(n, "an assembly step", general, {"type", "hold", "t0"});
+    if (type == "assembly") applies(n, "an assembly step", general, {"type", "hold", "t0", "mode_check", "mode_check_deg"});
     if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
     if (integrates)
       applies(n, "a " + type + " step", general,
@@ -714,6 +714,14 @@ struct Loader {
     if (!(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
     if (!(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
     s.quiet_until = quiet_until.value_or(s.quiet_until);
+    s.mode_check = text(n, "mode_check", s.mode_check);
+    if (has(n, "mode_check") && n["mode_check"].IsScalar() && s.mode_check != "warn" && s.mode_check != "fail" &&
+        s.mode_check != "off")
+      error(n["mode_check"], "mode_check", "expected warn, fail or off, got " + quote(s.mode_check));
+    const auto mode_deg = opt_number(n, "mode_check_deg");
+    s.mode_check_deg = mode_deg.value_or(s.mode_check_deg);
+    if (mode_deg && !(s.mode_check_deg > 0 && s.mode_check_deg <= 180))
+      error(n["mode_check_deg"], "mode_check_deg", "out of range (0, 180], got " + format_number(s.mode_check_deg));
     s.quiet_sensors = names(n, "quiet_sensors");
     const bool times_ok = (t0 || !has(n, "t0")) && (t_end || !has(n, "t_end"));
     if (integrates && times_ok && !(s.t_end > s.t0))

@@ -302,6 +302,21 @@ TEST(SceneValidation, NegativeMaxStep) {
   expect_one(t, line_of(t, "max_step"), "max_step", "must not be negative");
 }
 
+TEST(SceneValidation, UnknownAssemblyModeCheck) {
+  const std::string t = with("{type: assembly}", "{type: assembly, mode_check: warning}");
+  expect_one(t, line_of(t, "mode_check"), "mode_check", "expected warn, fail or off, got 'warning'");
+}
+
+TEST(SceneValidation, AssemblyModeCheckAngleOutOfRange) {
+  const std::string t = with("{type: assembly}", "{type: assembly, mode_check_deg: 0}");
+  expect_one(t, line_of(t, "mode_check_deg"), "mode_check_deg", "out of range (0, 180]");
+}
+
+TEST(SceneValidation, ModeCheckOnlyForAssembly) {
+  const std::string t = with("atol: 1.0e-8", "atol: 1.0e-8, mode_check: fail");
+  expect_one(t, line_of(t, "mode_check"), "mode_check", "does not apply to");
+}
+
 // ---- References ------------------------------------------------------------------------------
 
 TEST(SceneValidation, UnknownParentBody) {
@@ -652,6 +667,24 @@ TEST_F(Executable, MissingFileExitsTwo) {
   const CliResult r = run("check '" + (dir / "nothing.yaml").string() + "'");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("cannot read the file"), std::string::npos) << r.output;
+}
+
+// The diagnosis of a drive past the mechanism's travel and the assembly-mode warning reach the
+// command line (docs/extreme-cases.md): on stderr, the same text as summary.json's.
+TEST_F(Executable, DrivePastTheTravelSaysWhyOnStderr) {
+  const std::string scene = std::string(MBDAE_SOURCE_DIR) + "/verification/studies/extreme/kinematics_past_travel.yaml";
+  const CliResult r = run("run '" + scene + "' --out '" + (dir / "out").string() + "'");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("mbdae: the mechanism cannot reach q4 = -1.9291"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the constraint Jacobian becomes singular"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("last reached configuration"), std::string::npos) << r.output;
+}
+
+TEST_F(Executable, AssemblyModeWarningOnStderrAlsoWhenQuiet) {
+  const std::string scene = std::string(MBDAE_SOURCE_DIR) + "/verification/studies/extreme/rough_guess_60deg_plus.yaml";
+  const CliResult r = run("run '" + scene + "' --out '" + (dir / "out").string() + "' --quiet");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("mbdae: warning: assembly converged far from the guess"), std::string::npos) << r.output;
 }
 
 TEST_F(Executable, UsageErrorExitsOne) {

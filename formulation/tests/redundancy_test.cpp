@@ -13,39 +13,9 @@ namespace mbdae {
 namespace {
 
 using testing::add_coordinate;
+using testing::four_bar;
 using testing::make_body;
 using testing::make_joint;
-
-// Crank (length 1) and rocker (length 1) on revolute joints about z at (0,0,0) and (2,0,0),
-// coupler (length 2) from the crank's tip; the cut closes the coupler on the rocker's tip with
-// another revolute joint about z. A parallelogram: crank and rocker stay parallel.
-Model four_bar(double angle) {
-  Model m;
-  m.bodies.push_back(make_body("crank", 1, Vec3(0.5, 0, 0), Vec3(0.01, 0.1, 0.1)));
-  m.bodies.push_back(make_body("coupler", 1, Vec3(1, 0, 0), Vec3(0.01, 0.3, 0.3)));
-  m.bodies.push_back(make_body("rocker", 1, Vec3(0.5, 0, 0), Vec3(0.01, 0.1, 0.1)));
-  m.bodies[0].points["tip"] = Vec3(1, 0, 0);
-  m.bodies[1].points["end"] = Vec3(2, 0, 0);
-  m.bodies[2].points["tip"] = Vec3(1, 0, 0);
-  m.joints.push_back(make_joint("j1", kGround, "crank", Vec3(0, 0, 0), "R3 ", {"a"}));
-  JointSpec j2 = make_joint("j2", "crank", "coupler", Vec3::Zero(), "R3 ", {"b"});
-  j2.anchor_point = "tip";
-  m.joints.push_back(j2);
-  m.joints.push_back(make_joint("j3", kGround, "rocker", Vec3(2, 0, 0), "R3 ", {"c"}));
-  add_coordinate(m, "a", angle);
-  add_coordinate(m, "b", -angle);
-  add_coordinate(m, "c", angle);
-  CutSpec cut;
-  cut.name = "close";
-  cut.type = CutSpec::Type::kRevolute;
-  cut.body1 = "coupler";
-  cut.point1 = "end";
-  cut.body2 = "rocker";
-  cut.point2 = "tip";
-  cut.axis1 = cut.axis2 = Vec3::UnitZ();
-  m.cuts.push_back(cut);
-  return m;
-}
 
 TEST(Redundancy, PlanarFourBarHasThreeRedundantEquations) {
   for (double angle : {0.3, 1.2, 2.5}) {

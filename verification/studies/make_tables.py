@@ -247,6 +247,7 @@ def extreme_case(args):
         "wall_seconds": args.wall,
         "status": (summary or {}).get("status", "no summary"),
         "message": (summary or {}).get("message", ""),
+        "warnings": (summary or {}).get("warnings", []),
         "t_reached": (step or {}).get("t_reached"),
         "t_end": None,
         "steps": st.get("steps"),
@@ -265,7 +266,9 @@ def extreme_case(args):
         for s in summary.get("steps", []):
             if s.get("status") not in (None, "ok"):
                 out["failed_step"] = s.get("type")
-    if args.stderr and os.path.exists(args.stderr) and not out["message"]:
+    # A failure without a message in summary.json: its stderr (a run that ends well may print
+    # warnings there, which are in summary.json already).
+    if args.stderr and os.path.exists(args.stderr) and not out["message"] and str(args.exit) != "0":
         lines = [l.strip() for l in open(args.stderr) if l.strip()]
         out["message"] = " / ".join(lines[-3:])
     if args.ref:
@@ -318,6 +321,9 @@ def extreme_doc(args):
         if r.get("message"):
             messages.append("- **%s** (exit %s, %s): `%s`" % (n, r["exit_code"], r["status"],
                                                               r["message"].replace("`", "'")))
+        for w in r.get("warnings", []):
+            messages.append("- **%s** (exit %s, %s, warning): `%s`" % (n, r["exit_code"], r["status"],
+                                                                       w.replace("`", "'")))
         if ref and ref.get("failed_candidates"):
             ref_failures.append("- **%s**: %s" % (n, ref["failed_candidates"]))
         if r.get("nonfinite_output"):
@@ -329,7 +335,8 @@ def extreme_doc(args):
                  "(assembly and equilibrium included) on a shared machine. Long runs (--long) keep the result of "
                  "their last run; the date of each result is in `docs/studies/extreme/NAME.json`.")
     lines.append("")
-    lines.append("Messages, exactly as mbdae wrote them (`summary.json` field `message`):")
+    lines.append("Messages and warnings, exactly as mbdae wrote them (`summary.json` fields `message` and "
+                 "`warnings`):")
     lines.append("")
     lines.extend(messages if messages else ["- none"])
     if ref_failures:

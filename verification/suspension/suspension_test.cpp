@@ -150,8 +150,11 @@ TEST(Suspension, GroundStepNothingMovesBeforeTheStepAndEventsAreLocated) {
   const int z = column(r, "wheel_z"), az = column(r, "wheel_az");
   // Free fall right after the step: the wheel's acceleration is that of the whole unsprung
   // assembly under gravity and the spring (downwards, larger than g is possible with the spring).
-  for (const auto& row : r.rows)
-    if (row[0] > 0.2005 && row[0] < 0.21) EXPECT_LT(row[az], -9.0) << row[0];
+  for (const auto& row : r.rows) {
+    if (row[0] > 0.2005 && row[0] < 0.21) {
+      EXPECT_LT(row[az], -9.0) << row[0];
+    }
+  }
   // Before the step the wheel is at rest at its equilibrium height.
   EXPECT_NEAR(r.rows.front()[z], 0.277971383717455, 1e-9);
 }

@@ -1,0 +1,92 @@
+#include "cases/failure_diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "formulation/sensors.h"
+#include "formulation/singularity.h"
+
+namespace mbdae {
+namespace {
+
+std::string num(double x, int digits = 6) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
+}
+
+}  // namespace
+
+FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vector<char>& modes,
+                                              const std::vector<int>& columns, const double* q,
+                                              const double* v, double t, double t_input,
+                                              double condition, const std::string& solver_message) {
+  using json = nlohmann::ordered_json;
+  FailureDiagnosis out;
+  // The last configuration: driven coordinates (their value and the drive's), then the sensors
+  // of the output file (no accelerations: they need a solve at a configuration that may be
+  // singular).
+  std::vector<double> values(sys.sensors.size(), 0.0);
+  evaluate_sensors(sys, modes, q, v, nullptr, t_input, values.data());
+  json coords = json::object(), drives = json::object(), sensors = json::object();
+  std::ostringstream reached, targets;
+  for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
+    const JointCoordinate& c = sys.coordinates[k];
+    const double value = coordinate_value(sys, k, q);
+    coords[c.name] = value;
+    if (c.merged || c.spec.mode != CoordinateSpec::Mode::kDriven) continue;
+    const double target = c.spec.drive.value(t_input);
+    drives[c.name] = {{"reached", value}, {"drive", target}};
+    targets << (targets.tellp() > 0 ? ", " : "") << c.name << " = " << num(target, 10);
+    reached << (reached.tellp() > 0 ? ", " : "") << c.name << " = " << num(value, 10);
+  }
+  for (int s : columns) {
+    const Sensor& sensor = sys.sensors[s];
+    if (sensor.type == SensorSpec::Type::kAcceleration) continue;
+    sensors[sensor.name] = values[s];
+    if (drives.contains(sensor.name)) continue;  // already listed
+    reached << (reached.tellp() > 0 ? ", " : "") << sensor.name << " = " << num(values[s], 10);
+  }
+  out.details["last_configuration"] = {{"t", t}, {"drives", drives}, {"coordinates", coords}, {"sensors", sensors}};
+
+  const SingularityReport r = diagnose_singularity(sys, q, t_input);
+  const double ratio = r.largest_singular_value > 0 ? r.smallest_singular_value / r.largest_singular_value : 0.0;
+  out.singular = r.rank < r.equations || ratio < kSingularRatio;
+  json dependent = json::array();
+  for (const auto& d : r.dependent) dependent.push_back({{"equation", d.label}, {"weight", d.weight}});
+  out.details["constraint_jacobian"] = {{"singular", out.singular},
+                                        {"condition_estimate", condition},
+                                        {"smallest_singular_value", r.smallest_singular_value},
+                                        {"largest_singular_value", r.largest_singular_value},
+                                        {"rank", r.rank},
+                                        {"equations", r.equations},
+                                        {"losing_rank", r.constraints},
+                                        {"dependent_equations", dependent}};
+  if (!out.singular) return out;
+
+  std::ostringstream os;
+  if (targets.tellp() > 0)
+    os << "the mechanism cannot reach " << targets.str() << " at t = " << num(t, 10) << ": ";
+  else
+    os << "the mechanism reached a singular configuration at t = " << num(t, 10) << ": ";
+  os << "the constraint Jacobian becomes singular (condition estimate " << num(condition, 3)
+     << ", smallest singular value of the row-normalized Jacobian " << num(r.smallest_singular_value, 3)
+     << ", largest " << num(r.largest_singular_value, 3) << "), the constraints that lose rank are ";
+  // Joints, cuts and drives whose equations weigh at least half the largest in the dependent
+  // combination (the Euler-parameter norms, bodies' own equations, are left to summary.json).
+  std::vector<std::string> named;
+  for (const auto& d : r.dependent) {
+    const std::string g = constraint_group(d.label);
+    if (d.weight < kNamedWeight || g.rfind("body ", 0) == 0) continue;
+    if (std::find(named.begin(), named.end(), g) == named.end()) named.push_back(g);
+  }
+  for (size_t i = 0; i < named.size(); ++i) os << (i ? ", " : "") << named[i];
+  os << " (largest weights first; all in summary.json); last reached configuration (t = " << num(t, 10) << "): " << reached.str() << " (solver: "
+     << solver_message << ")";
+  out.message = os.str();
+  return out;
+}
+
+}  // namespace mbdae

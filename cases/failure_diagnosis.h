@@ -1,0 +1,38 @@
+// What a failed integration leaves in summary.json and in its message: the last configuration
+// reached, and, when the constraint Jacobian there is (nearly) singular, the diagnosis of
+// formulation/singularity.h: "the mechanism cannot reach q4 = X at t = T: the constraint Jacobian
+// becomes singular (...), the constraints that lose rank are ..., last reached configuration ...".
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "formulation/system.h"
+
+namespace mbdae {
+
+// The Jacobian counts as singular where the row-normalized Phi_q has s_min / s_max below this.
+// Measured on the suspension's kinematic drive: 0.048 at the design angle, 1.9e-3 at 0.004 rad
+// short of the end of rod 2's travel, 2e-5 where the drive past the travel fails (1.8e-6 rad
+// short of it; s_min goes like the square root of the distance to the fold).
+constexpr double kSingularRatio = 1e-4;
+// The message names the joints, cuts and drives with an equation of at least this weight.
+constexpr double kNamedWeight = 0.5;
+
+struct FailureDiagnosis {
+  bool singular = false;
+  std::string message;       // the replacement message when singular (else empty)
+  nlohmann::ordered_json details;  // "last_configuration" and "singular_configuration" entries
+};
+
+// q and v at the last step reached (time t, inputs evaluated at t_input); `columns` are the
+// sensors of the output file (reported in the last configuration, accelerations left out);
+// `condition` is the constraint condition estimate at q (AugmentedSolver::constraint_condition).
+FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vector<char>& modes,
+                                              const std::vector<int>& columns, const double* q,
+                                              const double* v, double t, double t_input,
+                                              double condition, const std::string& solver_message);
+
+}  // namespace mbdae

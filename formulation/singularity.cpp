@@ -1,0 +1,173 @@
+#include "formulation/singularity.h"
+
+#include <SuiteSparseQR.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "formulation/mechanics.h"
+#include "formulation/redundancy.h"
+
+namespace mbdae {
+namespace {
+
+// Label of each scalar equation (row) of Phi_q.
+std::vector<std::string> row_labels(const System& sys) {
+  std::vector<std::string> out;
+  for (const Constraint& c : sys.constraints) {
+    if (c.type != Constraint::Type::kPoint) {
+      out.push_back(c.label);
+      continue;
+    }
+    for (int comp = 0; comp < 3; ++comp)
+      if (c.mask & (1 << comp)) out.push_back(c.label + " [" + "xyz"[comp] + "]");
+  }
+  return out;
+}
+
+// (D Phi_q)^T: nq x nc, column j = row j of Phi_q scaled to unit norm.
+cholmod_sparse* normalized_jacobian_transpose(const System& sys, const double* q, cholmod_common* cc) {
+  const std::vector<int> off = constraint_offsets(sys);
+  const int nc = off.back(), nq = sys.nq();
+  std::vector<std::vector<std::pair<int, double>>> cols(nc);
+  Row14 rows[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
+    for (int r = 0; r < c.rows(); ++r) {
+      const double norm = rows[r].norm();
+      std::vector<std::pair<int, double>>& col = cols[off[k] + r];
+      for (int l = 0; l < 14; ++l) {
+        const int b = l < 7 ? c.bi : c.bj;
+        if (b < 0 || rows[r](l) == 0.0 || norm == 0.0) continue;
+        col.push_back({7 * b + l % 7, rows[r](l) / norm});
+      }
+      // The same body on both sides (never in a built system) would give duplicate rows.
+      std::sort(col.begin(), col.end());
+    }
+  }
+  size_t nnz = 0;
+  for (auto& col : cols) nnz += col.size();
+  cholmod_sparse* a = cholmod_l_allocate_sparse(nq, nc, nnz, 1, 1, 0, CHOLMOD_REAL, cc);
+  auto* ap = static_cast<SuiteSparse_long*>(a->p);
+  auto* ai = static_cast<SuiteSparse_long*>(a->i);
+  auto* ax = static_cast<double*>(a->x);
+  size_t pos = 0;
+  for (int j = 0; j < nc; ++j) {
+    ap[j] = pos;
+    for (auto& [i, v] : cols[j]) {
+      ai[pos] = i;
+      ax[pos++] = v;
+    }
+  }
+  ap[nc] = pos;
+  return a;
+}
+
+double norm2(const double* x, int n) {
+  double s = 0;
+  for (int i = 0; i < n; ++i) s += x[i] * x[i];
+  return std::sqrt(s);
+}
+
+}  // namespace
+
+std::string constraint_group(const std::string& label) {
+  for (const char* prefix : {"drive ", "lock ", "hold "}) {
+    if (label.rfind(prefix, 0) == 0) {
+      const size_t end = label.find(' ', std::string(prefix).size());
+      return label.substr(0, end);
+    }
+  }
+  size_t end = label.find(':');
+  if (end == std::string::npos) end = label.size();
+  const size_t paren = label.find(" (");
+  if (paren < end) end = paren;
+  return label.substr(0, end);
+}
+
+SingularityReport diagnose_singularity(const System& sys, const double* q, double t, double min_weight) {
+  SingularityReport report;
+  const int nc = sys.num_constraint_rows();
+  report.equations = nc;
+  if (nc == 0) return report;
+  const std::vector<std::string> labels = row_labels(sys);
+  std::vector<double> weight(nc, 0.0);
+
+  cholmod_common cc;
+  cholmod_l_start(&cc);
+  cholmod_sparse* a = normalized_jacobian_transpose(sys, q, &cc);
+  SuiteSparseQR_factorization<double>* qr =
+      SuiteSparseQR_factorize<double>(SPQR_ORDERING_DEFAULT, SPQR_DEFAULT_TOL, a, &cc);
+  report.rank = qr ? static_cast<int>(qr->rank) : 0;
+  if (qr && report.rank == nc) {
+    // Inverse iteration: x <- (A^T A)^-1 x = E R^-1 R^-T E^T x (A E = Q R).
+    cholmod_dense* x = cholmod_l_allocate_dense(nc, 1, nc, CHOLMOD_REAL, &cc);
+    auto* xv = static_cast<double*>(x->x);
+    for (int i = 0; i < nc; ++i) xv[i] = 1.0 + 0.01 * (i % 7);  // not orthogonal to anything simple
+    double lambda = 0;
+    for (int it = 0; it < 50; ++it) {
+      const double n0 = norm2(xv, nc);
+      for (int i = 0; i < nc; ++i) xv[i] /= n0;
+      cholmod_dense* b = SuiteSparseQR_solve<double>(SPQR_RTX_EQUALS_ETB, qr, x, &cc);
+      cholmod_dense* z = b ? SuiteSparseQR_solve<double>(SPQR_RETX_EQUALS_B, qr, b, &cc) : nullptr;
+      if (b) cholmod_l_free_dense(&b, &cc);
+      if (!z) break;
+      const auto* zv = static_cast<const double*>(z->x);
+      const double lambda_new = norm2(zv, nc);
+      std::copy(zv, zv + nc, xv);
+      cholmod_l_free_dense(&z, &cc);
+      const bool settled = std::fabs(lambda_new - lambda) <= 1e-10 * lambda_new;
+      lambda = lambda_new;
+      if (settled && it > 2) break;
+    }
+    const double n0 = norm2(xv, nc);
+    double ymax = 0;
+    for (int i = 0; i < nc; ++i) ymax = std::fmax(ymax, std::fabs(xv[i]));
+    for (int i = 0; i < nc; ++i) weight[i] = ymax > 0 ? std::fabs(xv[i]) / ymax : 0.0;
+    report.smallest_singular_value = lambda > 0 && n0 > 0 ? 1.0 / std::sqrt(lambda) : 0.0;
+    cholmod_l_free_dense(&x, &cc);
+  }
+  // Largest singular value: power iteration on A^T A.
+  {
+    cholmod_dense* x = cholmod_l_allocate_dense(nc, 1, nc, CHOLMOD_REAL, &cc);
+    cholmod_dense* w = cholmod_l_allocate_dense(a->nrow, 1, a->nrow, CHOLMOD_REAL, &cc);
+    auto* xv = static_cast<double*>(x->x);
+    std::fill(xv, xv + nc, 1.0);
+    double one[2] = {1, 0}, zero[2] = {0, 0}, s2 = 0;
+    for (int it = 0; it < 30; ++it) {
+      const double n0 = norm2(xv, nc);
+      for (int i = 0; i < nc; ++i) xv[i] /= n0;
+      cholmod_l_sdmult(a, 0, one, zero, x, w, &cc);  // w = A x
+      cholmod_l_sdmult(a, 1, one, zero, w, x, &cc);  // x = A^T w
+      s2 = norm2(xv, nc);
+    }
+    report.largest_singular_value = std::sqrt(s2);
+    cholmod_l_free_dense(&x, &cc);
+    cholmod_l_free_dense(&w, &cc);
+  }
+  if (qr) SuiteSparseQR_free<double>(&qr, &cc);
+  cholmod_l_free_sparse(&a, &cc);
+  cholmod_l_finish(&cc);
+
+  if (report.rank < nc) {
+    // Exactly dependent: name the equations the redundancy check would remove.
+    System copy = sys;
+    const RedundancyReport rr = find_redundant_constraints(copy, q, t, false);
+    for (const auto& r : rr.redundant) report.dependent.push_back({r, 1.0});
+  } else {
+    std::vector<int> idx;
+    for (int i = 0; i < nc; ++i)
+      if (weight[i] >= min_weight) idx.push_back(i);
+    std::stable_sort(idx.begin(), idx.end(), [&](int i, int j) { return weight[i] > weight[j]; });
+    for (int i : idx) report.dependent.push_back({labels[i], weight[i]});
+  }
+  for (const auto& d : report.dependent) {
+    const std::string g = constraint_group(d.label);
+    if (std::find(report.constraints.begin(), report.constraints.end(), g) == report.constraints.end())
+      report.constraints.push_back(g);
+  }
+  return report;
+}
+
+}  // namespace mbdae

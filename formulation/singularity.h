@@ -1,0 +1,48 @@
+// Diagnosis of a singular configuration: the constraint equations that become linearly dependent
+// at a configuration where the constraint Jacobian Phi_q (nearly) loses rank, for example a
+// kinematic drive pushed to the end of the mechanism's travel.
+//
+// With the rows of Phi_q scaled to unit norm (D Phi_q), the smallest singular value s_min and its
+// left singular vector y (one weight per equation, y^T D Phi_q = s_min u^T) are found by inverse
+// iteration on (D Phi_q Phi_q^T D)^-1 with a sparse QR of (D Phi_q)^T (SuiteSparseQR, as the
+// redundancy check). y is the combination of equations that stops constraining anything: the
+// equations with a large |y_i| are those that lose rank (physically, the joints that carry a
+// self-stressed reaction, a "dead centre"). Equations left out of the combination (|y_i| = 0)
+// are untouched by the singularity. Euler-parameter norm rows take part whenever a loaded point
+// constraint does (A s is quadratic in p: its rows have a component along p that the norm's
+// multiplier balances); they are the bodies' own equations, not joints.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "formulation/system.h"
+
+namespace mbdae {
+
+struct DependentEquation {
+  std::string label;  // the constraint's label ("<label> [x]" for one row of a point constraint)
+  double weight = 0;  // |y_i| / max_j |y_j|
+};
+
+struct SingularityReport {
+  int equations = 0;
+  int rank = 0;                       // numerical rank of D Phi_q (SuiteSparseQR's default tolerance)
+  double smallest_singular_value = 0;  // s_min of D Phi_q (0 if rank < equations)
+  double largest_singular_value = 0;   // estimate (power iteration), for the ratio
+  std::vector<DependentEquation> dependent;  // weight >= min_weight, largest first
+  // The joints, cuts, drives and bodies those equations belong to ("joint rod2_mount",
+  // "cut ball2", "drive q4", "body rod3"), in order of their largest weight.
+  std::vector<std::string> constraints;
+};
+
+// Analyzes Phi_q at (q, t). Exact dependencies (rank < equations) are named like the redundancy
+// check does (the last equation of each dependent set, weight 1).
+SingularityReport diagnose_singularity(const System& sys, const double* q, double t,
+                                       double min_weight = 0.05);
+
+// "joint rod2_mount" for "joint rod2_mount (R1 R3): origin at anchor", "drive q4" for
+// "drive q4 = piecewise linear, 2 knots", "cut ball2" for "cut ball2: coincident points".
+std::string constraint_group(const std::string& label);
+
+}  // namespace mbdae
