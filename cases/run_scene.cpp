@@ -168,7 +168,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
     write_summary();
     out.exit_code = 3;
     out.q = q;
-    if (opt.verbose) std::fprintf(stderr, "mbdae: %s\n", message.c_str());
+    std::fprintf(stderr, "mbdae: %s\n", message.c_str());  // also under --quiet: a failure is always said
   };
 
   for (const AnalysisStep& step : scene.steps) {

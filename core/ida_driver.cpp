@@ -30,7 +30,16 @@ struct UserData {
   const CscPattern* pattern;
   void* mem;
   double rtol, atol, h_initial;
+  std::string last_ida_error;  // IDA's own words about its last error (not printed)
 };
+
+// IDA prints its errors on stderr by default, also under `mbdae run --quiet`; keep the last one
+// for the failure message instead (warnings, error_code > 0, are dropped).
+void error_handler(int error_code, const char* module, const char* function, char* msg, void* ud) {
+  if (error_code >= 0) return;
+  auto* u = static_cast<UserData*>(ud);
+  u->last_ida_error = std::string(function) + ": " + msg;
+}
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
   auto* u = static_cast<UserData*>(ud);
@@ -130,7 +139,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   SUNLinearSolver ls = make_klu_linear_solver(pattern, ctx);
   void* mem = IDACreate(ctx);
   UserData ud{&problem, &pattern, mem, o.rtol, o.atol,
-              o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0)};
+              o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0), ""};
   const double h_cap = ud.h_initial;
   auto choose_initial_step = [&](double tt) {
     if (o.initial_step > 0) return;
@@ -141,6 +150,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   IDAInit(mem, residual_fn, o.t0, y, yp);
   IDAWFtolerances(mem, weights_fn);
   IDASetUserData(mem, &ud);
+  IDASetErrHandlerFn(mem, error_handler, &ud);
   IDASetId(mem, id);
   IDASetSuppressAlg(mem, SUNTRUE);
   IDASetLinearSolver(mem, ls, jac);
@@ -219,6 +229,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     os << "IDA failed at t = " << tt << " with step size " << h << " (" << IDAGetReturnFlagName(flag) << ")";
     const std::string worst = worst_components(mem, problem, ys, yps, id);
     if (!worst.empty()) os << "; largest error estimates: " << worst;
+    if (!ud.last_ida_error.empty()) os << "; IDA: " << ud.last_ida_error;
     stats.ok = false;
     stats.status = "integration_failed";
     stats.message = os.str();
