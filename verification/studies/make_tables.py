@@ -127,8 +127,8 @@ def work_precision(args):
             ", ".join(meta.get("formulations_run", [])) or "none",
             "; ".join("%s (%s)" % (k, v.split(": ")[-1]) for k, v in skipped.items()) or "none"))
         parts.append("- Ladder: rtol = tau, atol = %g tau. cpu_median: median over %d run(s) of the integration "
-                     "step's `cpu_seconds` (process CPU time, output samples included: projection, "
-                     "accelerations and sensors at every sample); cpu_no_output_median: the same runs with "
+                     "step's `cpu_seconds` (process CPU time, output samples included: "
+                     "an acceleration solve and the sensors at every sample, and a projection where the scene asks for one); cpu_no_output_median: the same runs with "
                      "samples at t0 and t_end only (their step count: steps_no_output); wall_median: wall time of the whole "
                      "scene (assembly and equilibrium included) on a shared machine." % (meta["atol_ratio"],
                                                                                           meta["repeat"]))

@@ -6,7 +6,7 @@
 // ladder, the scene runs with rtol = tau, atol = atol_ratio * tau (default 1e-6 tau, the
 // suspension tests' ladder: the rods' Euler parameters pass through zero, where only atol limits
 // their error), N times. Recorded: the median CPU time of the integration step (summary:
-// statistics.cpu_seconds, which includes the output samples' projection and sensors), the same
+// statistics.cpu_seconds, which includes the output samples' acceleration solves and sensors), the same
 // without output samples (N more runs with samples at t0 and t_end only: IDA runs in one-step
 // mode and interpolates samples, so the steps should be identical; their count is recorded and a
 // difference is reported), the median wall time of the whole
