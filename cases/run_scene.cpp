@@ -16,6 +16,7 @@
 #include "formulation/ggl_dae.h"
 #include "formulation/index1_dae.h"
 #include "formulation/index3_dae.h"
+#include "formulation/initial_velocities.h"
 #include "formulation/mechanics.h"
 #include "formulation/augmented_solver.h"
 #include "formulation/redundancy.h"
@@ -314,7 +315,20 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
         std::copy(q.begin(), q.end(), y.begin());
         try {
+          if (!step.initial_velocities.empty()) {
+            // Given rates of joint coordinates; the rest of v from the constraints.
+            std::vector<CoordinateRate> rates;
+            for (const auto& [name, rate] : step.initial_velocities)
+              rates.push_back({sys.coordinate_index(name), rate});
+            solve_initial_velocities(sys, y.data(), step.t0, rates, y.data() + sys.nq());
+          }
           dae.consistent_initial_values(step.t0, y, yp);
+          if (!step.initial_velocities.empty()) {
+            json rates;
+            for (const auto& [name, rate] : step.initial_velocities)
+              rates[name] = coordinate_rate(sys, sys.coordinate_index(name), y.data(), y.data() + sys.nq());
+            js["initial_velocities"] = rates;  // as reached after the consistent start
+          }
         } catch (const SolveError& e) {
           fail(e.status, e.what(), js);
           return false;

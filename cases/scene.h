@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "formulation/model.h"
@@ -26,6 +27,9 @@ struct AnalysisStep {
   // guess (formulation/assembly_mode.h): "warn" (summary and stderr), "fail" (exit 3) or "off".
   std::string mode_check = "warn";
   double mode_check_deg = 90;
+  // Dynamics: rates of free joint coordinates at t0 (rad/s or m/s), in scene order; the other
+  // velocities follow from the constraints (formulation/initial_velocities.h).
+  std::vector<std::pair<std::string, double>> initial_velocities;
   SourceLocation where;
 };
 

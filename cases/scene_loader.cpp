@@ -669,7 +669,7 @@ struct Loader {
     s.where = where(n);
     static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
                                    "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "newton_convergence", "output_projection",
-                                   "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg"};
+                                   "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg", "initial_velocities"};
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
     if (type == "assembly") s.type = AnalysisStep::Type::kAssembly;
@@ -683,7 +683,26 @@ struct Loader {
     if (integrates)
       applies(n, "a " + type + " step", general,
               {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "newton_convergence", "output_projection",
-               "quiet_until", "quiet_sensors"});
+               "quiet_until", "quiet_sensors", "initial_velocities"});
+    if (type == "kinematics" && has(n, "initial_velocities"))
+      error(n["initial_velocities"], "initial_velocities",
+            "does not apply to a kinematics step (its velocities follow from the drives)");
+    if (has(n, "initial_velocities")) {
+      const YAML::Node iv = n["initial_velocities"];
+      record(n, "initial_velocities", iv);
+      if (!iv.IsMap()) {
+        error(iv, "initial_velocities", "expected a mapping of coordinate names to rates, got " + describe(iv));
+      } else {
+        for (const auto& kv : iv) {
+          if (!kv.first.IsScalar()) {
+            error(kv.first, "initial_velocities", "expected a coordinate name, got " + describe(kv.first));
+            continue;
+          }
+          const std::string field = "initial_velocities." + kv.first.Scalar();
+          if (const auto x = to_number(kv.second, field)) s.initial_velocities.emplace_back(kv.first.Scalar(), *x);
+        }
+      }
+    }
     s.hold = names(n, "hold");
     s.release = names(n, "release");
     s.unknowns = names(n, "unknowns");

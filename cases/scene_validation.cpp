@@ -565,6 +565,23 @@ struct Validator {
                  "one released coordinate is needed per unknown parameter (" + std::to_string(s.release.size()) +
                      " released, " + std::to_string(s.unknowns.size()) + " unknown)");
       }
+      {
+        std::set<std::string> seen;
+        for (const auto& [n, rate] : s.initial_velocities) {
+          const std::string f = "initial_velocities";
+          if (!joint_of_coordinate.count(n)) {
+            report(s.where, f, "no joint coordinate named '" + n + "'" + suggestion(n, keys(joint_of_coordinate)));
+            continue;
+          }
+          const auto it = m.coordinates.find(n);
+          const auto mode = it == m.coordinates.end() ? CoordinateSpec::Mode::kFree : it->second.mode;
+          if (mode == CoordinateSpec::Mode::kLocked || merged_coordinates.count(n))
+            report(s.where, f, "coordinate '" + n + "' is locked: its rate is 0, not a free initial velocity");
+          else if (mode == CoordinateSpec::Mode::kDriven)
+            report(s.where, f, "coordinate '" + n + "' is driven: its rate at t0 is its drive's");
+          if (!seen.insert(n).second) report(s.where, f, "coordinate '" + n + "' is listed twice");
+        }
+      }
       if (s.type == A::kKinematics || s.type == A::kDynamics)
         for (size_t k = 0; k < s.quiet_sensors.size(); ++k)
           if (!sensor_index.count(s.quiet_sensors[k]))

@@ -317,6 +317,33 @@ TEST(SceneValidation, ModeCheckOnlyForAssembly) {
   expect_one(t, line_of(t, "mode_check"), "mode_check", "does not apply to");
 }
 
+TEST(SceneValidation, InitialVelocityOfUnknownCoordinate) {
+  const std::string t = with("atol: 1.0e-8}", "atol: 1.0e-8, initial_velocities: {thta: 1.0}}");
+  expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "no joint coordinate named 'thta'; did you mean 'theta'?");
+}
+
+TEST(SceneValidation, InitialVelocityNotANumber) {
+  const std::string t = with("atol: 1.0e-8}", "atol: 1.0e-8, initial_velocities: {theta: fast}}");
+  expect_one(t, line_of(t, "initial_velocities"), "initial_velocities.theta", "expected a number, got 'fast'");
+}
+
+TEST(SceneValidation, InitialVelocitiesNotAMapping) {
+  const std::string t = with("atol: 1.0e-8}", "atol: 1.0e-8, initial_velocities: [theta, 1]}");
+  expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "expected a mapping of coordinate names to rates");
+}
+
+TEST(SceneValidation, InitialVelocityOfDrivenCoordinate) {
+  std::string t = with("theta: {initial_deg: 30}", "theta: {initial_deg: 30, mode: driven, drive: 0.5}");
+  t = with("  - {type: equilibrium, hold: [theta], release: [theta], unknowns: [spring.free_length]}\n", "", t);
+  t = with("atol: 1.0e-8}", "atol: 1.0e-8, initial_velocities: {theta: 1.0}}", t);
+  expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "coordinate 'theta' is driven");
+}
+
+TEST(SceneValidation, InitialVelocitiesOnlyForDynamics) {
+  const std::string t = with("{type: assembly}", "{type: assembly, initial_velocities: {theta: 1.0}}");
+  expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "does not apply to");
+}
+
 // ---- References ------------------------------------------------------------------------------
 
 TEST(SceneValidation, UnknownParentBody) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -134,8 +135,13 @@ TEST(Reference, EllipticIntegralByAgm) {
 
 // --- a. Compound pendulum ------------------------------------------------------------------------
 
-TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
-  // compound_pendulum.yaml: hinge = y axis of a base frame turned by Rz(30 deg) Rx(25 deg).
+// compound_pendulum.yaml's pendulum, computed here from its constants: a rotation about a fixed
+// axis, I theta'' = -m g_perp d sin(theta - theta_eq).
+struct CompoundPendulumReference {
+  double i_hinge, stiffness, theta_eq, amplitude, period;
+};
+CompoundPendulumReference compound_pendulum_reference() {
+  // Hinge = y axis of a base frame turned by Rz(30 deg) Rx(25 deg).
   const double m = 2.5, g = 9.81, amplitude = 60 * kDeg;
   const Vector3d com(0.15, 0.08, -0.4);  // from the hinge, pendulum axes
   Matrix3d inertia;                      // about the centre of mass, pendulum axes
@@ -143,16 +149,38 @@ TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
   const Matrix3d base = rz(30 * kDeg) * rx(25 * kDeg);
   const Vector3d axis = Vector3d::UnitY();  // in base (and pendulum) axes
 
-  // Rotation about a fixed axis: only the gravity and centre-of-mass components across the axis
-  // count. I = a.J a + m d^2 about the hinge; the equilibrium turns c_perp onto g_perp.
+  // Only the gravity and centre-of-mass components across the axis count. I = a.J a + m d^2
+  // about the hinge; the equilibrium turns c_perp onto g_perp.
   const Vector3d g_base = base.transpose() * Vector3d(0, 0, -g);
   const Vector3d g_perp = g_base - g_base.dot(axis) * axis;
   const Vector3d c_perp = com - com.dot(axis) * axis;
   const double d = c_perp.norm();
-  const double i_hinge = axis.dot(inertia * axis) + m * d * d;
-  const double theta_eq = std::atan2(axis.dot(c_perp.cross(g_perp)), c_perp.dot(g_perp));
-  const double stiffness = m * g_perp.norm() * d;  // m g_perp d: I theta'' = -m g_perp d sin(theta - theta_eq)
-  const double period = 4.0 * std::sqrt(i_hinge / stiffness) * elliptic_k(std::sin(amplitude / 2));
+  CompoundPendulumReference ref;
+  ref.i_hinge = axis.dot(inertia * axis) + m * d * d;
+  ref.theta_eq = std::atan2(axis.dot(c_perp.cross(g_perp)), c_perp.dot(g_perp));
+  ref.stiffness = m * g_perp.norm() * d;
+  ref.amplitude = amplitude;
+  ref.period = 4.0 * std::sqrt(ref.i_hinge / ref.stiffness) * elliptic_k(std::sin(amplitude / 2));
+  return ref;
+}
+
+// Period from the downward crossings of theta - theta_eq.
+double measured_period(const mbdae::RunOutcome& r, double theta_eq) {
+  const auto t = series(r, "t"), theta = series(r, "theta"), rate = series(r, "theta_rate");
+  std::vector<double> u(theta.size());
+  for (size_t i = 0; i < u.size(); ++i) u[i] = theta[i] - theta_eq;
+  const std::vector<double> crossings = downward_crossings(t, u, rate);
+  if (crossings.size() < 6) {
+    ADD_FAILURE() << "only " << crossings.size() << " crossings";
+    return 0;
+  }
+  return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+}
+
+TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
+  const CompoundPendulumReference ref = compound_pendulum_reference();
+  const double i_hinge = ref.i_hinge, stiffness = ref.stiffness, theta_eq = ref.theta_eq;
+  const double amplitude = ref.amplitude, period = ref.period;
 
   const mbdae::RunOutcome r = run("compound_pendulum.yaml");
   expect_ran_to(r, 10.5);
@@ -163,13 +191,9 @@ TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
 
   std::vector<double> u(theta.size());
   for (size_t i = 0; i < u.size(); ++i) u[i] = theta[i] - theta_eq;
-  const std::vector<double> crossings = downward_crossings(t, u, rate);
-  ASSERT_GE(crossings.size(), 6u);
-  const double n = static_cast<double>(crossings.size() - 1);
-  const double measured = (crossings.back() - crossings.front()) / n;
+  const double measured = measured_period(r, theta_eq);
   const double rel = (measured - period) / period;
-  std::printf("  period: exact %.15f s, measured %.15f s over %.0f periods, relative error %.3e\n",
-              period, measured, n, rel);
+  std::printf("  period: exact %.15f s, measured %.15f s, relative error %.3e\n", period, measured, rel);
   EXPECT_LT(std::fabs(rel), 1e-8);
 
   // The energy sensors against the same reference: T = 1/2 I theta'^2 and
@@ -186,6 +210,100 @@ TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
   EXPECT_LT(ke_err / scale, 1e-10);
   EXPECT_LT(pe_err / scale, 1e-10);
   expect_clean_integration(r, "compound pendulum");
+}
+
+// The same pendulum started at its equilibrium angle with the rate that carries it to the same
+// 60 deg amplitude, from the scene field `initial_velocities`: theta'(0)^2 = 2 m g_perp d
+// (1 - cos A) / I. Same period, and the rate at t = 0 is the one asked for.
+TEST(CompoundPendulum, InitialVelocityGivesTheSameSwing) {
+  const CompoundPendulumReference ref = compound_pendulum_reference();
+  const double rate0 = std::sqrt(2 * ref.stiffness * (1 - std::cos(ref.amplitude)) / ref.i_hinge);
+  std::ifstream in(scene_path("compound_pendulum.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string scene = text.str();
+  const std::string start = "theta: {initial_deg: 80.556045219583467}";
+  const size_t at = scene.find(start);
+  ASSERT_NE(at, std::string::npos);
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "theta: {initial: %.17g}", ref.theta_eq);
+  scene.replace(at, start.size(), buf);
+  const std::string step = "{type: dynamics, ";
+  const size_t st = scene.rfind(step);
+  ASSERT_NE(st, std::string::npos);
+  std::snprintf(buf, sizeof buf, "{type: dynamics, initial_velocities: {theta: %.17g}, ", rate0);
+  scene.replace(st, step.size(), buf);
+  mbdae::RunOptions o;
+  o.keep_rows = true;
+  o.verbose = false;
+  o.progress = false;
+  o.rtol = kTightRtol;
+  o.atol = kTightAtol;
+  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("compound_pendulum.yaml")), o);
+  expect_ran_to(r, 10.5);
+  const auto theta = series(r, "theta"), rate = series(r, "theta_rate");
+  EXPECT_NEAR(theta[0], ref.theta_eq, 1e-12);
+  EXPECT_NEAR(rate[0], rate0, 1e-12 * rate0);
+  EXPECT_NEAR(integration_step(r)["initial_velocities"]["theta"].get<double>(), rate0, 1e-12 * rate0);
+  double largest = 0;
+  for (double x : theta) largest = std::max(largest, x - ref.theta_eq);
+  const double measured = measured_period(r, ref.theta_eq);
+  std::printf("  from theta'(0) = %.12f rad/s: amplitude %.12f deg (60), period %.15f s (exact %.15f)\n",
+              rate0, largest / kDeg, measured, ref.period);
+  EXPECT_NEAR(largest, ref.amplitude, 1e-6);  // the samples are 2 ms apart: the top is between them
+  EXPECT_LT(std::fabs(measured - ref.period) / ref.period, 1e-8);
+  expect_clean_integration(r, "compound pendulum from an initial velocity");
+}
+
+// slider_crank.yaml with the crank free at phi = 0.6 rad: the crank's rate alone sets every
+// velocity (one degree of freedom), x' = -r w sin(phi) - r^2 w sin(phi) cos(phi) / sqrt(l^2 -
+// r^2 sin^2(phi)); a rate of x as well over-determines the motion and is refused.
+std::string free_slider_crank(const std::string& rates) {
+  std::ifstream in(scene_path("slider_crank.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string scene = text.str();
+  const std::string driven = "phi: {initial: 0, mode: driven, drive: {type: polynomial, coefficients: [0, 6.283185307179586]}}";
+  const size_t at = scene.find(driven);
+  if (at == std::string::npos) return "";
+  scene.replace(at, driven.size(), "phi: {initial: 0.6}");
+  const size_t an = scene.find("analysis:");
+  scene = scene.substr(0, an) + "analysis:\n  - {type: assembly, hold: [phi]}\n"
+          "  - {type: dynamics, t_end: 0.01, output_step: 0.001, rtol: 1.0e-12, atol: 1.0e-14, initial_velocities: {" +
+          rates + "}}\n";
+  return scene;
+}
+
+TEST(SliderCrank, InitialCrankRateSetsThePistonRate) {
+  const std::string scene = free_slider_crank("phi: 6.283185307179586");
+  ASSERT_FALSE(scene.empty());
+  mbdae::RunOptions o;
+  o.keep_rows = true;
+  o.verbose = false;
+  o.progress = false;
+  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("slider_crank.yaml")), o);
+  ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
+  const double rr = 0.1, l = 0.35, w = 2 * kPi, phi = 0.6;
+  const double sn = std::sin(phi), cs = std::cos(phi);
+  const double x_rate = -rr * w * sn - rr * rr * w * sn * cs / std::sqrt(l * l - rr * rr * sn * sn);
+  const auto x = series(r, "x"), rate = series(r, "x_rate");
+  std::printf("  piston rate at phi = 0.6 rad, phi' = 2 pi: %.15f m/s (exact %.15f)\n", rate[0], x_rate);
+  EXPECT_NEAR(x[0], rr * cs + std::sqrt(l * l - rr * rr * sn * sn), 1e-12);
+  EXPECT_NEAR(rate[0], x_rate, 1e-12);
+  EXPECT_NEAR(integration_step(r)["initial_velocities"]["phi"].get<double>(), w, 1e-12);
+}
+
+TEST(SliderCrank, InitialRatesBeyondTheDegreesOfFreedomAreRefused) {
+  const std::string scene = free_slider_crank("phi: 6.283185307179586, x: 1.0");
+  ASSERT_FALSE(scene.empty());
+  mbdae::RunOptions o;
+  o.verbose = false;
+  o.progress = false;
+  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("slider_crank.yaml")), o);
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.summary["status"], "inconsistent_initial_velocities") << r.summary.dump(2);
+  const std::string message = r.summary.value("message", "");
+  EXPECT_NE(message.find("initial rate of"), std::string::npos) << message;
 }
 
 // --- b. Spatial double pendulum ---------------------------------------------------------------
