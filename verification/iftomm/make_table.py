@@ -454,7 +454,7 @@ NOTES = """
   formulation** (`formulation: penalty`, `formulation/index1_dae.h`, [docs/formulation.md](formulation.md)
   "Singular configurations"): lambda = p (Phi'' + 2 alpha Phi' + beta^2 Phi), whose Newton
   matrix stays regular, with p = 1e7 kg and alpha = beta = 1000/s. It passes all 20 crossings
-  with B0 within 6.4e-5 m of the reference (first row; 10.8 s CPU), the crank angles equal to
+  with B0 within 6.4e-5 m of the reference (first row; about 11 s CPU), the crank angles equal to
   5e-7 rad and the constraints violated by at most 1.5e-10 m (the penalty's bias). The index-3
   rows show the earlier state: with the earlier scene settings IDA fails (IDA_CONV_FAIL) just
   before the first crossing, and with loose tolerances it completes but misses the high-precision
