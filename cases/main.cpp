@@ -1,5 +1,6 @@
 // mbdae command-line front end:
-//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--formulation index3|index2-ggl|index1]
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT]
+//                         [--formulation index3|index2-ggl|index1|penalty]
 // Exit codes: 0 success, 1 usage, 2 invalid scene, 3 solve failure.
 #include <cstdio>
 #include <cstdlib>
@@ -16,7 +17,7 @@ void usage() {
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
                "                  [--output-step DT]\n"
-               "                  [--formulation index3|index2-ggl|index1]\n"
+               "                  [--formulation index3|index2-ggl|index1|penalty]\n"
                "       mbdae check SCENE.yaml\n");
 }
 bool parse_number(const char* s, double& v) {
@@ -54,8 +55,9 @@ int main(int argc, char** argv) {
       opt.output_step = v;
     } else if (a == "--formulation" && i + 1 < argc) {
       opt.formulation = argv[++i];
-      if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1") {
-        std::fprintf(stderr, "mbdae: --formulation expects index3, index2-ggl or index1, got '%s'\n",
+      if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1" &&
+          opt.formulation != "penalty") {
+        std::fprintf(stderr, "mbdae: --formulation expects index3, index2-ggl, index1 or penalty, got '%s'\n",
                      opt.formulation.c_str());
         return 1;
       }

@@ -434,8 +434,10 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         if (formulation == "index2-ggl") {
           GglDae dae(sys, scale);
           integrated = integrate_dae(dae);
-        } else if (formulation == "index1") {
-          Index1Dae dae(sys, scale, BaumgarteParameters{step.baumgarte_alpha, step.baumgarte_beta});
+        } else if (formulation == "index1" || formulation == "penalty") {
+          const double penalty = formulation == "penalty" ? step.penalty : 0.0;
+          if (penalty > 0) js["penalty"] = penalty;
+          Index1Dae dae(sys, scale, BaumgarteParameters{step.baumgarte_alpha, step.baumgarte_beta}, false, penalty);
           integrated = integrate_dae(dae);
         } else {
           Index3Dae dae(sys, scale);

@@ -19,7 +19,7 @@ struct RunOptions {
   bool progress = true;       // progress line on stderr for runs over a second
   bool keep_rows = false;     // keep results in memory (tests)
   bool verbose = true;        // print assembly / equilibrium results on stdout
-  std::string formulation;    // non-empty: overrides the steps' formulation (index3, index2-ggl, index1)
+  std::string formulation;    // non-empty: overrides the steps' formulation (index3, index2-ggl, index1, penalty)
 };
 
 struct RunOutcome {

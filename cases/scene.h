@@ -18,8 +18,9 @@ struct AnalysisStep {
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
   bool output_projection = false;    // project output samples onto the constraints
-  std::string formulation = "index3";  // index3, index2-ggl or index1
-  double baumgarte_alpha = 20.0, baumgarte_beta = 20.0;  // index1: stabilization [1/s]
+  std::string formulation = "index3";  // index3, index2-ggl, index1 or penalty
+  double baumgarte_alpha = 20.0, baumgarte_beta = 20.0;  // index1, penalty: stabilization [1/s]
+  double penalty = 1e7;  // penalty: p = penalty * largest body mass [kg] (formulation/index1_dae.h)
   // Report the largest change of these sensors before this time ("nothing moves before").
   double quiet_until = -1;
   std::vector<std::string> quiet_sensors;

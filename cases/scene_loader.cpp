@@ -668,7 +668,7 @@ struct Loader {
     AnalysisStep s;
     s.where = where(n);
     static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
-                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "newton_convergence", "output_projection",
+                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
                                    "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg", "initial_velocities"};
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
@@ -682,7 +682,7 @@ struct Loader {
     if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
     if (integrates)
       applies(n, "a " + type + " step", general,
-              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "newton_convergence", "output_projection",
+              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
                "quiet_until", "quiet_sensors", "initial_velocities"});
     if (type == "kinematics" && has(n, "initial_velocities"))
       error(n["initial_velocities"], "initial_velocities",
@@ -732,6 +732,8 @@ struct Loader {
     s.baumgarte_beta = opt_number(n, "baumgarte_beta").value_or(s.baumgarte_beta);
     if (!(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
     if (!(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
+    s.penalty = opt_number(n, "penalty").value_or(s.penalty);
+    if (!(s.penalty > 0)) error(at(n, "penalty"), "penalty", "must be positive, got " + format_number(s.penalty));
     s.quiet_until = quiet_until.value_or(s.quiet_until);
     s.mode_check = text(n, "mode_check", s.mode_check);
     if (has(n, "mode_check") && n["mode_check"].IsScalar() && s.mode_check != "warn" && s.mode_check != "fail" &&
@@ -761,9 +763,9 @@ struct Loader {
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
     if (has(n, "formulation") && n["formulation"].IsScalar() && s.formulation != "index3" &&
-        s.formulation != "index2-ggl" && s.formulation != "index1")
+        s.formulation != "index2-ggl" && s.formulation != "index1" && s.formulation != "penalty")
       error(n["formulation"], "formulation",
-            "unknown formulation " + quote(s.formulation) + " (index3, index2-ggl, index1)");
+            "unknown formulation " + quote(s.formulation) + " (index3, index2-ggl, index1, penalty)");
     if (integrates && !s.quiet_sensors.empty() && !has(n, "quiet_until"))
       error(n["quiet_sensors"], "quiet_until", "missing (quiet_sensors are watched until quiet_until)");
     return s;

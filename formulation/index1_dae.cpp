@@ -8,8 +8,9 @@
 namespace mbdae {
 
 Index1Dae::Index1Dae(const System& sys, double constraint_scale, BaumgarteParameters baumgarte,
-                     bool exact_gamma_q)
+                     bool exact_gamma_q, double penalty)
     : MultibodyDae(sys), scale_(constraint_scale), bg_(baumgarte), exact_gamma_q_(exact_gamma_q) {
+  if (penalty > 0) inverse_penalty_ = 1.0 / (penalty * mass_scale_);
   record_pattern();
 }
 
@@ -18,7 +19,9 @@ int Index1Dae::residual(double t_in, const double* y, const double* yp, double* 
   kinematic_and_momentum_residual(t, y, yp, r, work_.data());
   double* f3 = r + 2 * nq_;
   stabilized_acceleration_constraints(sys_, offsets_, y, y + nq_, yp + nq_, t, bg_.alpha, bg_.beta, f3);
-  for (int i = 0; i < nc_; ++i) f3[i] *= scale_;
+  // Penalty (when set): F3 = s (stabilized acceleration constraints - lambda / p).
+  const double* lambda = y + 2 * nq_;
+  for (int i = 0; i < nc_; ++i) f3[i] = scale_ * (f3[i] - inverse_penalty_ * lambda[i]);
   return finite_or_retry(r, size());
 }
 
@@ -39,6 +42,9 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
   // F3, v columns: s [(cj + 2 alpha) Phi_q + 2 (H_k v)^T].
   assemble_constraint_jacobian(sys_, offsets_, q, scale_ * (cj + 2.0 * a), ra, cv, -1, -1, asm_);
   assemble_hessian_vector_rows(sys_, offsets_, q, v, 2.0 * scale_, nullptr, 0.0, ra, cv, asm_);
+  // F3, lambda columns (penalty only): -s/p I.
+  if (inverse_penalty_ > 0)
+    for (int i = 0; i < nc_; ++i) asm_.add(ra + i, cl + i, -scale_ * inverse_penalty_);
 }
 
 void Index1Dae::error_test_mask(double* id) const {

@@ -39,6 +39,25 @@
 // (Point and norm rows have constant Hessians: their block is exactly zero.)
 // All other blocks are exact: F3 in q columns: s [(H_k v')^T + 2 alpha (H_k v)^T + beta^2 Phi_q],
 // in v columns: s [2 (H_k v)^T + (cj + 2 alpha) Phi_q].
+//
+// Penalty (formulation "penalty"; Bayo, Garcia de Jalon and Serna 1988, the penalty form the
+// augmented-Lagrangian ALI3-P of Bayo and Ledesma 1996 builds on): with penalty > 0,
+//   F3 = s [Phi_q v' - gamma + 2 alpha Phi' + beta^2 Phi - lambda / p],   p = penalty m_ref,
+// i.e. lambda = p (Phi'' + 2 alpha Phi' + beta^2 Phi): the constraint forces are penalty forces
+// on the stabilized constraint dynamics. The multipliers stay unknowns (and outputs); in the
+// Newton matrix, whose F2 and F3 rows are [cj M .. , Phi_q^T; s cj Phi_q .. , -s/p I],
+// eliminating lambda leaves cj M + p cj Phi_q^T Phi_q (+ derivatives): positive definite also
+// where Phi_q loses rank (singular configurations), where the index-3, GGL and plain index-1
+// matrices are singular (M + p Phi_q^T Phi_q is definite when every direction of zero kinetic
+// energy is constrained: Euler-parameter norms, the axial rotation of a slender rod). Initial
+// values: a and lambda of the exact constraints (their F3 residual, s |lambda| / p, is removed
+// by the first Newton iteration). The price: the constraints hold up to the penalty's bias,
+// Phi'' + 2 alpha Phi' + beta^2 Phi = lambda / p, so |Phi| ~ |lambda| / (p beta^2) in steady
+// state (A02: p = 1e7 kg, beta = 1000/s, |lambda| ~ 1e2 N: 1e-11 m). Near a singular
+// configuration a violation Phi_u along the row direction u being lost becomes a motion
+// Phi_u / sigma of the mode that u stops constraining (sigma the vanishing singular value of
+// Phi_q), so the bias must be small: large p beta^2 (A02 measurements in docs/formulation.md).
+// penalty = 0: the exact index-1 equations (no term, no pattern entry).
 #pragma once
 
 #include "core/sparse_assembler.h"
@@ -53,8 +72,9 @@ struct BaumgarteParameters {
 
 class Index1Dae : public MultibodyDae {
  public:
+  // penalty: the factor of the largest body mass giving p (0: exact index-1 equations).
   explicit Index1Dae(const System& sys, double constraint_scale = 1.0,
-                     BaumgarteParameters baumgarte = {}, bool exact_gamma_q = false);
+                     BaumgarteParameters baumgarte = {}, bool exact_gamma_q = false, double penalty = 0.0);
 
   int size() const override { return 2 * nq_ + nc_; }
   int residual(double t, const double* y, const double* yp, double* r) override;
@@ -70,12 +90,15 @@ class Index1Dae : public MultibodyDae {
 
   bool velocities_error_tested() const override { return true; }
   const BaumgarteParameters& baumgarte() const { return bg_; }
+  // 1/p of the penalty term (0 without penalty).
+  double inverse_penalty() const { return inverse_penalty_; }
 
  private:
   void assemble(double t, double cj, const double* y, const double* yp) override;
   double scale_;
   BaumgarteParameters bg_;
   bool exact_gamma_q_;
+  double inverse_penalty_ = 0.0;
 };
 
 }  // namespace mbdae

@@ -274,6 +274,13 @@ TEST(SceneValidation, NonPositiveOutputStep) {
   expect_one(t, line_of(t, "output_step: 0"), "output_step", "must be positive");
 }
 
+TEST(SceneValidation, PenaltyFormulation) {
+  const std::string ok = with("atol: 1.0e-8}", "atol: 1.0e-8, formulation: penalty, penalty: 1.0e9}");
+  EXPECT_TRUE(errors_of(ok).empty()) << joined(errors_of(ok));
+  const std::string t = with("atol: 1.0e-8}", "atol: 1.0e-8, formulation: penalty, penalty: 0}");
+  expect_one(t, line_of(t, "penalty: 0"), "penalty", "must be positive");
+}
+
 TEST(SceneValidation, TooManyOutputRows) {
   const std::string t = with("output_step: 0.01", "output_step: 1.0e-12");
   expect_one(t, line_of(t, "output_step:"), "output_step", "more than 1e8 output rows");

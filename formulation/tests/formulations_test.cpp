@@ -162,6 +162,46 @@ TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
   EXPECT_EQ((omitted.topRows(2 * nq)).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(Formulations, PenaltyResidualAndNewtonMatrix) {
+  // F3 = s [index-1 rows - lambda / p], p = penalty * largest mass; the Newton matrix (with
+  // d(gamma)/dq by differences, as in the index-1 test) against central differences, and its
+  // lambda block exactly -s/p I.
+  const System sys = build_system(testing::all_types_model());
+  const double scale = 7.0, penalty = 1e3;
+  const BaumgarteParameters bg{3.0, 5.0};
+  Index1Dae plain(sys, scale, bg, true), pen(sys, scale, bg, true, penalty);
+  double m_ref = 1e-3;
+  for (const auto& b : sys.bodies) m_ref = std::max(m_ref, b.mass);
+  EXPECT_DOUBLE_EQ(pen.inverse_penalty(), 1.0 / (penalty * m_ref));
+  EXPECT_EQ(plain.inverse_penalty(), 0.0);
+  const State st = random_state(sys, 5);
+  const int n = pen.size(), nq = sys.nq(), nc = sys.num_constraint_rows();
+  std::vector<double> y(n), yp(n, 0.0);
+  std::copy(st.q.begin(), st.q.end(), y.begin());
+  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
+  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
+  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
+  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  const double cj = 37.0, t = 0.3;
+  for (auto& m : pen.modes) m = 1;
+  for (auto& m : plain.modes) m = 1;
+  std::vector<double> rp(n), rn(n);
+  pen.residual(t, y.data(), yp.data(), rp.data());
+  plain.residual(t, y.data(), yp.data(), rn.data());
+  for (int i = 0; i < 2 * nq; ++i) EXPECT_EQ(rp[i], rn[i]);
+  for (int i = 0; i < nc; ++i)
+    EXPECT_NEAR(rp[2 * nq + i], rn[2 * nq + i] - scale * st.lambda[i] / (penalty * m_ref),
+                1e-12 * (1 + std::fabs(rn[2 * nq + i])));
+  const Eigen::MatrixXd an = analytic_matrix(pen, t, cj, y, yp), fd = fd_matrix(pen, t, cj, y, yp);
+  const double worst = compare(pen, an, fd, 1e-5, "penalty");
+  const Eigen::MatrixXd block = an.block(2 * nq, 2 * nq, nc, nc);
+  EXPECT_NEAR((block + scale / (penalty * m_ref) * Eigen::MatrixXd::Identity(nc, nc)).cwiseAbs().maxCoeff(), 0.0,
+              1e-15);
+  // Without penalty the pattern has no lambda-lambda entries.
+  EXPECT_EQ(plain.jacobian_pattern().nnz() + nc, pen.jacobian_pattern().nnz());
+  std::printf("  penalty Newton matrix (%d x %d): worst relative error %.2e\n", n, n, worst);
+}
+
 // --- b. Compound pendulum ------------------------------------------------------------------------
 
 // A formulation that also records, per third of the run, the largest |Phi| and |Phi_q v + Phi_t|

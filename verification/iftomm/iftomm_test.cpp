@@ -10,8 +10,9 @@
 // The benchmark's error measure where it is published (A01, A02): the largest error of the
 // reported coordinates over the output samples, against 1e-3 ("high precision"). Each test also
 // asserts a tighter bound near what mbdae achieves, so that a loss of accuracy is seen.
-// Where a run is shortened (A01: the IFToMM version's 10 s instead of 2000 s; A02: up to the
-// first singular configuration), the full runs are in verification/iftomm/make_table.py.
+// Where a run is shortened (A01: the IFToMM version's 10 s instead of 2000 s; A02: 5 s, five
+// singular configurations, instead of 20 s; A02 at index 3: up to the first singular
+// configuration), the full runs are in verification/iftomm/make_table.py.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -238,7 +239,10 @@ TEST(A01SimplePendulum, MatchesExactSolution) {
 // (docs/iftomm-benchmarks-sources.md, section 2.2).
 constexpr double kA02FirstSingular = 0.721581024826;
 
-void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tight) {
+// `bias`: the constraint violation the formulation allows by construction (0 for the exact
+// index-3 constraints; the penalty formulation's |lambda| / (p beta^2), formulation/index1_dae.h),
+// added to the bounds that compare with exact kinematics (B0 at t = 0, crank angle spread).
+void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tight, double bias = 0) {
   EXPECT_EQ(redundant_count(r), 3 * n) << r.summary["redundant_constraints"].dump(1);
   EXPECT_EQ(r.summary["redundant_constraints"]["equations"].get<int>(), 5 * (3 * n + 1) + 2 * n + 1);
   EXPECT_EQ(r.summary["redundant_constraints"]["rank"].get<int>(), 5 * (3 * n + 1) + 2 * n + 1 - 3 * n);
@@ -250,7 +254,7 @@ void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tigh
   ASSERT_GE(i0, 0);
   std::printf("  t = 0: B0 = (%.3e, 1 %+.3e), v_B0 = (1 %+.3e, %.3e)\n", x[i0], y[i0] - 1, vx[i0] - 1, vy[i0]);
   EXPECT_NEAR(x[i0], 0.0, 1e-7);
-  EXPECT_NEAR(y[i0], 1.0, 1e-12);
+  EXPECT_NEAR(y[i0], 1.0, 1e-12 + bias);
   EXPECT_NEAR(vx[i0], 1.0, 1e-6);
   EXPECT_NEAR(vy[i0], 0.0, 1e-6);
   std::vector<double> times(t.begin() + i0, t.end());
@@ -271,15 +275,26 @@ void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tigh
   EXPECT_LT(ep, 1e-3);  // benchmark, high precision
   EXPECT_LT(ep, tight);
   EXPECT_LT(ee, 1e3 * tight);
-  EXPECT_LT(spread, 1e-8);  // on the parallelogram branch
+  EXPECT_LT(spread, 1e-8 + 10 * bias);  // on the parallelogram branch (the other is O(1) away)
 }
 
 // Up to the first singular configuration (0.72 s). The run goes to 0.70 s, but only the samples
 // up to 0.65 s are compared and required: close to the singular configuration, and on the last
 // step before the end time (see docs/iftomm-benchmarks.md, engine findings), IDA may fail with
 // IDA_CONV_FAIL, which is reported but not asserted here.
-mbdae::RunOutcome run_before_singular(const std::string& scene) {
-  const mbdae::RunOutcome r = run(scene, 0.70);
+mbdae::RunOutcome run_before_singular(const std::string& name) {
+  // The index-3 integration (exact constraints), with the scenes' tolerances and the Newton
+  // convergence coefficient it was tuned with; the scenes themselves use the penalty formulation.
+  mbdae::Scene scene = mbdae::load_scene(scene_path(name));
+  mbdae::AnalysisStep& step = integration_step(scene);
+  step.t_end = 0.70;
+  step.formulation = "index3";
+  step.newton_convergence = 0.001;
+  mbdae::RunOptions o;
+  o.keep_rows = true;
+  o.verbose = false;
+  o.progress = false;
+  const mbdae::RunOutcome r = mbdae::run_scene(scene, o);
   if (r.exit_code != 0)
     std::printf("  note: the run to 0.70 s stopped: %s\n", r.summary.value("message", std::string()).c_str());
   EXPECT_TRUE(r.exit_code == 0 || r.summary["status"] == "integration_failed");
@@ -308,23 +323,44 @@ TEST(A02NFourBar, N2UpToTheFirstSingularConfiguration) {
   check_four_bar(r, 2, t_end, 1e-6);
 }
 
-// The benchmark proper (shortened to 5 s): the mechanism passes the horizontal singular
-// configuration (N extra instantaneous degrees of freedom) four times a revolution, the first at
-// 0.72 s. mbdae's index-3 Newton matrix is singular there, and IDA fails with repeated corrector
-// convergence failures (IDA_CONV_FAIL) at the first or second crossing for every tolerance
-// tried (docs/iftomm-benchmarks.md). Disabled until mbdae handles singular configurations; run
-// with --gtest_also_run_disabled_tests.
-TEST(A02NFourBar, DISABLED_N40PassesSingularConfigurations) {
-  const mbdae::RunOutcome r = run("A02_n_four_bar_N40.yaml", 5.0);
-  expect_ran_to(r, 5.0);
-  check_four_bar(r, 40, 5.0, 1e-4);
+// The benchmark proper (shortened to 5 s; the full 20 s run is in make_table.py): the mechanism
+// passes the horizontal singular configuration (N extra instantaneous degrees of freedom) twice
+// a revolution, the first at 0.72 s. The scene integrates the penalty formulation
+// (formulation/index1_dae.h), whose Newton matrix stays regular there; index3, index2-ggl and
+// index1 fail with IDA_CONV_FAIL at the first crossing (docs/iftomm-benchmarks.md).
+TEST(A02NFourBar, N40PassesSingularConfigurations) {
+  const double t_end = 5.0;
+  const mbdae::RunOutcome r = run("A02_n_four_bar_N40.yaml", t_end);
+  expect_ran_to(r, t_end);
+  // Horizontal configurations passed: sign changes of y_B0 = sin(theta), against the reference.
+  const auto t = series(r, "t"), y = series(r, "y_B0");
+  std::vector<double> times;
+  for (double ti : t)
+    if (ti >= 0) times.push_back(ti);
+  const auto ref = four_bar_reference(40, times);
+  int passed = 0, expected = 0;
+  for (size_t k = 1; k < times.size(); ++k) {
+    const size_t i = t.size() - times.size() + k;
+    passed += (y[i - 1] > 0) != (y[i] > 0);
+    expected += (std::sin(ref[k - 1].first) > 0) != (std::sin(ref[k].first) > 0);
+  }
+  std::printf("  horizontal configurations passed: %d (reference %d)\n", passed, expected);
+  EXPECT_EQ(passed, expected);
+  EXPECT_EQ(expected, 5);
+  // bias: |lambda| / (p beta^2) with |lambda| up to about 1e3 N (the prelude's push), p = 1e7 kg,
+  // beta = 1000/s: 1e-10 m.
+  check_four_bar(r, 40, t_end, 1e-5, 1e-10);
 }
 
 // Engine bug found with these scenes (scenes/repro_end_step_conv_fail.yaml, generated by
-// make_scenes.py): the A02 N = 40 four-bar to 0.60 s at rtol 1e-11, atol 1e-13 fails on its last
-// step, the one IDA shortens to land on the end time (IDA_CONV_FAIL at t = 0.599872); 0.59 and
-// 0.61 s complete, and so does the same integration without a stop time at the end. Disabled
-// until fixed.
+// make_scenes.py): the A02 N = 40 four-bar at index 3 to 0.60 s at rtol 1e-11, atol 1e-13,
+// newton_convergence 0.001 fails on its last step, the one IDA shortens to land on the end time
+// (IDA_CONV_FAIL at t = 0.599872); 0.59 and 0.61 s complete, and so does the same integration
+// without a stop time at the end. Not the singular-configuration limitation (0.12 s away): the
+// shortened step converges but fails the error test once, and each smaller retry converges less
+// well (index-3 condition ~ 1/h^2) than the Newton coefficient 0.001 asks; with 0.01 or 0.33, or
+// with the penalty formulation, it completes (docs/iftomm-benchmarks.md). Disabled until the
+// index-3 engine is fixed.
 TEST(EngineFindings, DISABLED_LastStepToTheEndTime) {
   mbdae::RunOptions o;
   o.keep_rows = true;
