@@ -207,7 +207,17 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
 
   double t = o.t0;
   size_t next_bp = 0;
-  auto next_stop = [&] { return next_bp < bps.size() ? bps[next_bp] : o.t1; };
+  // The end of the run is a stop time only where the inputs are not smooth there (a drive's
+  // last knot): elsewhere the last step may go past t1 and the end is interpolated like every
+  // sample. A last step shortened to land on t1 can fail at index 3, where the Newton matrix's
+  // condition grows as 1/h^2 (verification/iftomm: EngineFindings.LastStepToTheEndTime).
+  bool end_is_breakpoint = false;
+  for (double b : problem.breakpoints())
+    if (std::fabs(b - o.t1) <= 1e-12 * std::max(1.0, std::fabs(o.t1))) end_is_breakpoint = true;
+  const double t_beyond = o.t1 + (o.t1 - o.t0);
+  auto next_stop = [&] {
+    return next_bp < bps.size() ? bps[next_bp] : end_is_breakpoint ? o.t1 : t_beyond;
+  };
   // Only a real breakpoint ends a segment: the end of the run is no jump of the inputs.
   auto segment_end = [&] { return next_bp < bps.size() ? bps[next_bp] : 1e300; };
   IDASetStopTime(mem, next_stop());
@@ -240,6 +250,16 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
     if (flag < 0) {
       failure(flag, tret);
+      break;
+    }
+    if (tret > o.t1) {
+      // Past the end: the end state and the last samples are interpolated; a root beyond t1 is
+      // no event of this run.
+      if (flag != IDA_ROOT_RETURN) problem.after_step(tret, N_VGetArrayPointer(y));
+      emit_until(o.t1, true);
+      IDAGetDky(mem, o.t1, 0, y);
+      IDAGetDky(mem, o.t1, 1, yp);
+      t = o.t1;
       break;
     }
     // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
