@@ -2,11 +2,15 @@
 // modes of switching forces (wheel contact) and their events, restarts at events and
 // breakpoints, inputs evaluated with their left limit at the end of a segment, the initial step,
 // per-step statistics (constraint violation at position and velocity level, Euler-norm drift),
-// consistent initial values of q, v, accelerations and multipliers, and the projected output.
+// consistent initial values of q, v, accelerations and multipliers, the projected output, the
+// rows F1 = q' - v and F2 = M v' + Phi_q^T lambda - Q with their Newton-matrix blocks, and the
+// Newton matrix's sparse pattern (recorded once) and value pass.
 //
-// A formulation derives from MultibodyDae and provides size(), the residual, the Jacobian, the
-// error-test mask and weights, and consistent_initial_values() (which places q, v, a and lambda
-// from consistent_state() into its own y, y'). The first 2 nq components of y must be q and v.
+// A formulation derives from MultibodyDae and provides size(), the residual, assemble() (its
+// Newton matrix by add() calls; record_pattern() at the end of its constructor), the error-test
+// mask and weights, and consistent_initial_values() (which places q, v, a and lambda from
+// consistent_state() into its own y, y'). The first 2 nq components of y must be q and v, the
+// next nc lambda.
 #pragma once
 
 #include <cmath>
@@ -127,7 +131,7 @@ class MultibodyDae : public DaeProblem {
   // 20 to 360 times; at equal error the cost is the same (poster, 1e-6 m: 21926 steps against
   // 22108). The plain relative test keeps the accuracy a tolerance promises.
   void position_weights(const double* y, double rtol, double aq, double* w) const;
-  double newton_cj_ = 0;  // cj of the last Newton matrix (set by the formulations' jacobian())
+  double newton_cj_ = 0;  // cj of the last Newton matrix (set by jacobian())
 
   const System& sys_;
   std::vector<int> offsets_;
