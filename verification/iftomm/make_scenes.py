@@ -1,34 +1,24 @@
 #!/usr/bin/python3
 """Generates the IFToMM benchmark scenes that need computed numbers (verification/iftomm/scenes/).
 
-  make_scenes.py                 write A02 (N = 40 and N = 2) and A05 into scenes/
+  make_scenes.py                 write A02 (N = 40 and N = 2), A05 and the end-step reproducer into scenes/
   make_scenes.py a02 N [T_END]   print the A02 N four-bar scene for any N on stdout
 
 Sources of the data: docs/iftomm-benchmarks-sources.md (sections 2 and 4).
 
-Why there is a "prelude" before t = 0. mbdae scenes cannot give initial velocities: a dynamics
-step starts from the assembled positions at rest (Index3Dae::consistent_initial_values projects a
-zero velocity). A02 (x-velocity of B0 = 1 m/s) and A05 (shaft at 2 pi rad/s) do not start at
-rest, so each scene starts at t0 = -eps from rest and applies constant or piecewise-linear
-point forces, switched off at t = 0 by step functions (a breakpoint: the integrator stops and
-restarts there), that bring the mechanism exactly onto the benchmark's initial state at t = 0:
-
-  A02: one x force F at B0 on [-eps, 0). On the parallelogram branch the system is
-       M theta'' = -C cos(theta) - F L sin(theta); integrated backwards from (pi/2, -1) at t = 0,
-       F is the value for which theta'(-eps) = 0, and theta(-eps) is the start angle.
-  A05: a couple about the shaft axis (two opposite world-fixed x forces at shaft points
-       (0, +-a, z)); its torque is 2 a f cos(phi). With the rods and the sleeve held in their
-       initial positions the mechanism rotates rigidly, J phi'' = 2 a f cos(phi) (J = J(30, 30)),
-       solved backwards from (phi, phi') = (0, 2 pi) for f and phi(-eps). "Held" means: upward
-       forces m g at the centres of mass of the rods, balls and sleeve cancel gravity, and a
-       vertical force on each ball cancels the centrifugal generalized force of its rod,
-       F_z = j'(beta0) omega(t)^2 / (2 L cos(beta0)). That force is piecewise linear in time
-       with node values chosen so that its impulse over every segment equals that of the exact
-       omega(t)^2: the rods' rates are exactly zero at every node, in particular at t = 0.
-       The springs stay at their free length and do nothing. The mass matrix in (phi, s, beta1,
-       beta2) is diagonal, so the couple does not move the rods or the sleeve.
-Both preludes are checked by the tests (iftomm_test.cpp), which compare the state at t = 0 with
-the benchmark's.
+Initial velocities. A02 and A05 do not start at rest; their scenes start at t = 0 at the
+benchmark's initial configuration, and the dynamics step gives the benchmark's initial velocities
+as rates of free joint coordinates (`initial_velocities`, docs/scene-format.md; mbdae computes
+the other velocities from the constraints, formulation/initial_velocities.h):
+  A02: the crank rate th0' = -vx_B0 / (L sin theta0) = -1 rad/s that gives B0 (the tip of crank 0,
+       at theta0 = pi/2) the specified x-velocity 1 m/s; the other cranks and the couplers
+       follow from the loop constraints (one degree of freedom).
+  A05: the shaft spin phi' = 2 pi rad/s, and zero rates of the sleeve (s) and the rods (bA, bB):
+       everything turns rigidly with the shaft (section 4.1: v = omega0 e_z x r for all bodies).
+       The four rates fix all four degrees of freedom.
+The tests (iftomm_test.cpp) check the velocities at t = 0 against these specified values.
+(Before initial_velocities existed, the scenes started at t0 = -eps from rest and reached the
+initial state at t = 0 through point forces switched off at t = 0, a "prelude"; git history.)
 """
 import math
 import os
@@ -37,60 +27,26 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def rk4(f, y, t0, t1, n):
-    h = (t1 - t0) / n
-    t = t0
-    for _ in range(n):
-        k1 = f(t, y)
-        k2 = f(t + h / 2, [a + h / 2 * b for a, b in zip(y, k1)])
-        k3 = f(t + h / 2, [a + h / 2 * b for a, b in zip(y, k2)])
-        k4 = f(t + h, [a + h * b for a, b in zip(y, k3)])
-        y = [a + h / 6 * (b + 2 * c + 2 * d + e) for a, b, c, d, e in zip(y, k1, k2, k3, k4)]
-        t += h
-    return y
-
-
-def secant(g, x0, x1, tol=1e-14):
-    g0, g1 = g(x0), g(x1)
-    for _ in range(60):
-        if g1 == g0:
-            break
-        x2 = x1 - g1 * (x1 - x0) / (g1 - g0)
-        x0, g0, x1, g1 = x1, g1, x2, g(x2)
-        if abs(g1) < tol:
-            break
-    return x1
-
-
 def fmt(x):
     return repr(float(x))
 
 
 # --- A02 N four-bar ------------------------------------------------------------------------------
 
-A02_EPS = 0.05  # prelude length = output step (0.05 s, the spec's 400 output steps in 20 s)
+A02_OUTPUT_STEP = 0.05  # the spec's 400 output steps in 20 s
+A02_THETA0 = math.pi / 2  # cranks vertical ("the position shown in the figure")
+A02_VX_B0 = 1.0           # spec: initial x-velocity of B0, m/s
 
 
-def a02_prelude(n, eps=A02_EPS):
-    """Force F (N, world x, at B0) and start angle theta(-eps) of the prelude."""
-    m, length, g = 1.0, 1.0, 9.81
-    big_m = (n + 1) * m * length**2 / 3 + n * m * length**2
-    c = m * g * length * ((n + 1) / 2 + n)
-
-    def end_rate(force):
-        f = lambda t, y: [y[1], (-c * math.cos(y[0]) - force * length * math.sin(y[0])) / big_m]
-        return rk4(f, [math.pi / 2, -1.0], 0.0, -eps, 4000)
-
-    force = secant(lambda F: end_rate(F)[1], big_m / eps, 1.1 * big_m / eps)
-    theta_s = end_rate(force)[0]
-    return force, theta_s, big_m, c
+def a02_crank_rate(length=1.0):
+    """Rate of crank 0 giving B0 = L (cos th, sin th) the x-velocity -L sin(th) th' = A02_VX_B0."""
+    return -A02_VX_B0 / (length * math.sin(A02_THETA0))
 
 
 def a02_scene(n, t_end=20.0, penalty=True):
     """penalty: the benchmark's integration (passes the singular configurations); False: the
     index-3 integration of the earlier scenes (kept for the end-step reproducer)."""
-    force, theta_s, big_m, c = a02_prelude(n)
-    eps = A02_EPS
+    theta0, rate = A02_THETA0, a02_crank_rate()
     out = []
     w = out.append
     w(f"""# IFToMM / MBSBenchmark A02: N four-bar mechanism, N = {n} (generated by
@@ -107,10 +63,9 @@ def a02_scene(n, t_end=20.0, penalty=True):
 # i on the tip of crank i-1 (R3); loop cut i: revolute between coupler i's end and crank i's tip.
 # 5 (3N+1) joint equations + 2N+1 Euler norms; 3N of them are redundant in every configuration
 # (3 per planar loop) and are removed by mbdae (summary: redundant_constraints).
-# Prelude (make_scenes.py docstring): mbdae starts from rest, so the run starts at t0 = -{eps}
-# from crank angle theta_s = {fmt(theta_s)} rad and a force F = {fmt(force)} N in +x at B0
-# acts until t = 0; with M = {fmt(big_m)}, C = {fmt(c)} (M theta'' = -C cos theta on the
-# parallelogram branch) this gives exactly theta(0) = pi/2, theta'(0) = -1 rad/s, B0' = (1, 0).
+# Initial state (t = 0): cranks at theta = pi/2, couplers horizontal; initial_velocities gives
+# crank 0 the rate th0' = -vx_B0 / (L sin theta) = {fmt(rate)} rad/s (B0' = (1, 0) m/s); the
+# other cranks and the couplers follow from the loop constraints.
 name: A02_n_four_bar_N{n}
 gravity: [0, -9.81, 0]
 bodies:
@@ -127,18 +82,14 @@ bodies:
         w(f"  - {{name: pin{i}, parent: crank{i - 1}, child: coupler{i}, anchor: tip, chain: [R3], coordinates: [c{i}]}}\n")
     w("coordinates:\n")
     for i in range(n + 1):
-        w(f"  th{i}: {{initial: {fmt(theta_s)}}}\n")
+        w(f"  th{i}: {{initial: {fmt(theta0)}}}\n")
     for i in range(1, n + 1):
-        w(f"  c{i}: {{initial: {fmt(-theta_s)}}}\n")
+        w(f"  c{i}: {{initial: {fmt(-theta0)}}}\n")
     w("cuts:\n")
     for i in range(1, n + 1):
         w(f"  - {{name: close{i}, type: revolute, body1: coupler{i}, point1: end, body2: crank{i}, point2: tip, "
           f"axis1: [0, 0, 1], axis2: [0, 0, 1]}}\n")
-    w(f"""forces:
-  # Prelude only (t < 0): the push that gives B0 its initial velocity.
-  - {{name: push, type: point_force, body: crank0, point: tip,
-     fx: {{type: step, time: 0, before: {fmt(force)}, after: 0}}}}
-sensors:
+    w(f"""sensors:
   - {{name: x_B0, type: position, body: crank0, point: tip, component: x}}
   - {{name: y_B0, type: position, body: crank0, point: tip, component: y}}
   - {{name: vx_B0, type: velocity, body: crank0, point: tip, component: x}}
@@ -148,16 +99,19 @@ sensors:
   - {{name: theta0, type: coordinate, coordinate: th0}}
   - {{name: theta_mid, type: coordinate, coordinate: th{n // 2}}}
   - {{name: theta_last, type: coordinate, coordinate: th{n}}}
+  - {{name: rate0, type: coordinate_rate, coordinate: th0}}
+  - {{name: rate_mid, type: coordinate_rate, coordinate: th{n // 2}}}
+  - {{name: rate_last, type: coordinate_rate, coordinate: th{n}}}
   - {{name: kinetic, type: kinetic_energy}}
   - {{name: potential, type: potential_energy}}
   - {{name: energy, type: expression, expression: "kinetic + potential"}}
 analysis:
-  # output_step = prelude length: the samples fall on t = 0, 0.05, ..., the spec's 400 output steps.
-{analysis_text(eps, t_end) if penalty else index3_analysis_text(eps, t_end)}""")
+  # Samples at t = 0, 0.05, ..., the spec's 400 output steps.
+{analysis_text(t_end, rate) if penalty else index3_analysis_text(t_end, rate)}""")
     return "".join(out)
 
 
-def analysis_text(eps, t_end):
+def analysis_text(t_end, rate):
     """The penalty formulation (formulation/index1_dae.h): its Newton matrix stays regular at the
     horizontal singular configurations, where the index-3, GGL and index-1 ones are singular;
     penalty 1e7 and Baumgarte alpha = beta = 1000/s keep the constraint bias |lambda| / (p
@@ -168,30 +122,26 @@ def analysis_text(eps, t_end):
   # Baumgarte alpha = beta = 1000/s keep the penalty's constraint bias near 1e-11 m (with the
   # default 20/s each crossing costs about 0.05 J). atol = 1e-3 rtol: the couplers' Euler
   # parameters e1..e3 stay exactly 0 (docs/iftomm-benchmarks.md).
-  - {{type: dynamics, t0: -{eps}, t_end: {fmt(t_end)}, output_step: {eps}, rtol: 1.0e-10, atol: 1.0e-13,
-     formulation: penalty, penalty: 1.0e7, baumgarte_alpha: 1000, baumgarte_beta: 1000}}
+  - {{type: dynamics, t0: 0, t_end: {fmt(t_end)}, output_step: {A02_OUTPUT_STEP}, rtol: 1.0e-10, atol: 1.0e-13,
+     formulation: penalty, penalty: 1.0e7, baumgarte_alpha: 1000, baumgarte_beta: 1000, initial_velocities: {{th0: {fmt(rate)}}}}}
 """
 
 
-def index3_analysis_text(eps, t_end):
-    return f"""  # rtol 1e-10: B0 to about 4e-7 up to the first singular configuration (0.72 s), where IDA
-  # fails (IDA_CONV_FAIL; docs/iftomm-benchmarks.md). atol = 1e-3 rtol, not smaller: the
-  # couplers' Euler parameters e1..e3 stay exactly 0, and with atol 1e-6 rtol IDA's Newton
-  # iteration cannot meet their weights (IDA_CONV_FAIL at the start).
-  - {{type: dynamics, t0: -{eps}, t_end: {fmt(t_end)}, output_step: {eps}, rtol: 1.0e-10, atol: 1.0e-13,
-     newton_convergence: 0.001}}
+def index3_analysis_text(t_end, rate):
+    return f"""  # Index 3: IDA fails (IDA_CONV_FAIL) at the first singular configuration (0.72 s;
+  # docs/iftomm-benchmarks.md). atol = 1e-3 rtol, not smaller: the couplers' Euler parameters
+  # e1..e3 stay exactly 0, and with atol 1e-6 rtol IDA's Newton iteration cannot meet their weights.
+  - {{type: dynamics, t0: 0, t_end: {fmt(t_end)}, output_step: {A02_OUTPUT_STEP}, rtol: 1.0e-10, atol: 1.0e-13,
+     newton_convergence: 0.001, initial_velocities: {{th0: {fmt(rate)}}}}}
 """
 
 
 # --- A05 stiff flyball governor ------------------------------------------------------------------
 
-A05_EPS = 0.01     # prelude length = output step
-A05_SEGMENTS = 10  # piecewise-linear segments of the centrifugal compensation
+A05_OMEGA0 = 2 * math.pi  # initial shaft spin, rad/s (section 4.1)
 
 
 def a05_scene():
-    eps, nseg = A05_EPS, A05_SEGMENTS
-    g = 9.81
     rho, w_bar = 3000.0, 0.01
     length = 1.0
     m_r = round(rho * length * w_bar * w_bar, 12)  # 0.3 kg, shaft and rods
@@ -202,50 +152,13 @@ def a05_scene():
     m_b = 5.0
     a = 0.05                                     # hinge radius = sleeve attachment radius
     beta0 = math.radians(30)
-    omega0 = 2 * math.pi
+    omega0 = A05_OMEGA0
 
     def j_rod(b):
         return (m_b * (a + length * math.cos(b))**2 + m_r * (a + length / 2 * math.cos(b))**2
                 + i_ax * math.sin(b)**2 + i_t * math.cos(b)**2)
 
-    def dj_rod(b):
-        return (-2 * m_b * (a + length * math.cos(b)) * length * math.sin(b)
-                - m_r * (a + length / 2 * math.cos(b)) * length * math.sin(b)
-                + 2 * (i_ax - i_t) * math.sin(b) * math.cos(b))
-
     big_j = i_ax + i_s + 2 * j_rod(beta0)  # shaft I_zz = i_ax (square section, same as a rod)
-    lever, z_couple = 0.5, 0.5             # couple forces at shaft points (0, +-lever, z_couple)
-
-    def back(f, n=20000):
-        rhs = lambda t, y: [y[1], 2 * lever * f * math.cos(y[0]) / big_j]
-        return rk4(rhs, [0.0, omega0], 0.0, -eps, n)
-
-    f_couple = secant(lambda f: back(f)[1], big_j * omega0 / eps / (2 * lever),
-                      1.01 * big_j * omega0 / eps / (2 * lever))
-    phi_s = back(f_couple)[0]
-
-    # omega(t)^2 on a fine grid forward from (phi_s, 0), integrated per segment (Simpson).
-    sub = 200
-    h = eps / nseg
-    rhs = lambda t, y: [y[1], 2 * lever * f_couple * math.cos(y[0]) / big_j]
-    y = [phi_s, 0.0]
-    t = -eps
-    samples = [y[1]**2]
-    for _ in range(nseg * sub):
-        y = rk4(rhs, y, t, t + h / sub, 4)
-        t += h / sub
-        samples.append(y[1]**2)
-    integrals = []
-    for k in range(nseg):
-        s = samples[k * sub:(k + 1) * sub + 1]
-        integrals.append(h / sub / 3 * (s[0] + s[-1] + 4 * sum(s[1:-1:2]) + 2 * sum(s[2:-1:2])))
-    nodes = [0.0]
-    for k in range(nseg):
-        nodes.append(2 * integrals[k] / h - nodes[-1])
-    scale = dj_rod(beta0) / (2 * length * math.cos(beta0))  # F_z = scale * omega^2 (< 0: down)
-    points = ", ".join(f"[{fmt(-eps + k * h)}, {fmt(scale * v)}]" for k, v in enumerate(nodes))
-    points = points.replace(f"[{fmt(-eps + nseg * h)},", "[0.0,")
-    last = scale * nodes[-1]
     h0 = big_j * omega0
 
     return f"""# IFToMM / MBSBenchmark A05: stiff flyball governor (generated by verification/iftomm/make_scenes.py;
@@ -263,10 +176,8 @@ def a05_scene():
 #   angular velocity 2 pi rad/s (everything turns rigidly with it); gravity 9.81 in -z (OpenSim's
 #   createModel and Exudyn); 10 s as in Exudyn and the OpenSim rst (OpenSim's tex: 350 s).
 #   Reported: the sleeve coordinate s.
-# Prelude (make_scenes.py docstring): mbdae starts from rest, so the run starts at t0 = -{eps} with
-# the shaft at phi = {fmt(phi_s)} rad; until t = 0 a couple (f = {fmt(f_couple)} N at
-# +-{lever} m) spins it up rigidly to exactly 2 pi rad/s at phi = 0, while forces cancel gravity
-# and the rods' centrifugal load (piecewise linear, impulse-exact on each of {nseg} segments).
+# Initial state (t = 0): phi = 0, s = 0.5 m, rods at 30 deg; initial_velocities: phi' = 2 pi rad/s
+# and s' = bA' = bB' = 0 (rigid rotation with the shaft).
 # J(30 deg, 30 deg) = {fmt(big_j)} kg m^2; axial angular momentum H0 = {fmt(h0)} kg m^2/s.
 name: A05_stiff_flyball_governor
 gravity: [0, 0, -9.81]
@@ -275,7 +186,7 @@ bodies:
     mass: {fmt(m_r)}
     com: [0, 0, 0.5]
     inertia: {{xx: {fmt(i_t)}, yy: {fmt(i_t)}, zz: {fmt(i_ax)}}}
-    points: {{hingeA: [0.05, 0, 1], hingeB: [-0.05, 0, 1], couple1: [0, {lever}, {z_couple}], couple2: [0, -{lever}, {z_couple}]}}
+    points: {{hingeA: [0.05, 0, 1], hingeB: [-0.05, 0, 1]}}
   - name: sleeve
     mass: {fmt(m_s)}
     inertia: {{xx: {fmt(i_s)}, yy: {fmt(i_s)}, zz: {fmt(i_s)}}}
@@ -302,7 +213,7 @@ joints:
   - {{name: ball_weldA, parent: rodA, child: ballA, anchor: tip, chain: []}}
   - {{name: ball_weldB, parent: rodB, child: ballB, anchor: tip, chain: []}}
 coordinates:
-  phi: {{initial: {fmt(phi_s)}}}
+  phi: {{initial: 0}}
   s: {{initial: 0.5}}
   bA: {{initial_deg: 30}}
   bB: {{initial_deg: -30}}
@@ -311,18 +222,6 @@ forces:
      stiffness: 8.0e5, damping: 4.0e4, free_length: 0.5}}
   - {{name: springB, type: spring_damper, body1: sleeve, point1: springB, body2: rodB, point2: com,
      stiffness: 8.0e5, damping: 4.0e4, free_length: 0.5}}
-  # Prelude only (t < 0), see above.
-  - {{name: couple1, type: point_force, body: shaft, point: couple1, fx: {{type: step, time: 0, before: {fmt(-f_couple)}, after: 0}}}}
-  - {{name: couple2, type: point_force, body: shaft, point: couple2, fx: {{type: step, time: 0, before: {fmt(f_couple)}, after: 0}}}}
-  - {{name: lift_sleeve, type: point_force, body: sleeve, point: com, fz: {{type: step, time: 0, before: {fmt(m_s * g)}, after: 0}}}}
-  - {{name: lift_rodA, type: point_force, body: rodA, point: com, fz: {{type: step, time: 0, before: {fmt(m_r * g)}, after: 0}}}}
-  - {{name: lift_rodB, type: point_force, body: rodB, point: com, fz: {{type: step, time: 0, before: {fmt(m_r * g)}, after: 0}}}}
-  - {{name: lift_ballA, type: point_force, body: ballA, point: origin, fz: {{type: step, time: 0, before: {fmt(m_b * g)}, after: 0}}}}
-  - {{name: lift_ballB, type: point_force, body: ballB, point: origin, fz: {{type: step, time: 0, before: {fmt(m_b * g)}, after: 0}}}}
-  - {{name: hold_ballA, type: point_force, body: ballA, point: origin, fz: {{type: piecewise_linear, points: [{points}]}}}}
-  - {{name: hold_ballB, type: point_force, body: ballB, point: origin, fz: {{type: piecewise_linear, points: [{points}]}}}}
-  - {{name: hold_endA, type: point_force, body: ballA, point: origin, fz: {{type: step, time: 0, before: 0, after: {fmt(-last)}}}}}
-  - {{name: hold_endB, type: point_force, body: ballB, point: origin, fz: {{type: step, time: 0, before: 0, after: {fmt(-last)}}}}}
 sensors:
   - {{name: s, type: coordinate, coordinate: s}}
   - {{name: s_rate, type: coordinate_rate, coordinate: s}}
@@ -333,6 +232,9 @@ sensors:
   - {{name: bA_rate, type: coordinate_rate, coordinate: bA}}
   - {{name: bB_rate, type: coordinate_rate, coordinate: bB}}
   - {{name: sleeve_z, type: position, body: sleeve, point: com, component: z}}
+  - {{name: sleeve_vx, type: velocity, body: sleeve, point: springA, component: x}}
+  - {{name: sleeve_vy, type: velocity, body: sleeve, point: springA, component: y}}
+  - {{name: sleeve_vz, type: velocity, body: sleeve, point: springA, component: z}}
   - {{name: lengthA, type: force_length, force: springA}}
   - {{name: lengthB, type: force_length, force: springB}}
   # Axial angular momentum from the bodies' points and axes (mbdae has no momentum sensor):
@@ -348,8 +250,10 @@ sensors:
   - {{name: vyB, type: velocity, body: rodB, point: com, component: y}}
   - {{name: bxA, type: position, body: ballA, point: origin, component: x}}
   - {{name: byA, type: position, body: ballA, point: origin, component: y}}
+  - {{name: bzA, type: position, body: ballA, point: origin, component: z}}
   - {{name: bvxA, type: velocity, body: ballA, point: origin, component: x}}
   - {{name: bvyA, type: velocity, body: ballA, point: origin, component: y}}
+  - {{name: bvzA, type: velocity, body: ballA, point: origin, component: z}}
   - {{name: bxB, type: position, body: ballB, point: origin, component: x}}
   - {{name: byB, type: position, body: ballB, point: origin, component: y}}
   - {{name: bvxB, type: velocity, body: ballB, point: origin, component: x}}
@@ -362,34 +266,36 @@ sensors:
   - {{name: kinetic, type: kinetic_energy}}
   - {{name: potential, type: potential_energy}}
   - {{name: energy, type: expression, expression: "kinetic + potential"}}
-output: [s, s_rate, omega, phi, bA, bB, bA_rate, bB_rate, sleeve_z, lengthA, lengthB, H, kinetic, potential, energy]
+output: [s, s_rate, omega, phi, bA, bB, bA_rate, bB_rate, sleeve_z, sleeve_vx, sleeve_vy, sleeve_vz, bxA, bzA, bvxA, bvyA, bvzA, lengthA, lengthB, H, kinetic, potential, energy]
 analysis:
-  # output_step = prelude length: samples at t = 0, 0.01, ... rtol 1e-13 gives s to about 2e-9
-  # and H to 3e-9 (rtol 1e-11: 1e-6 and 1.3e-6; the energy dissipated in 10 s, 3.1e-3 J, needs
-  # rtol 1e-12 or less). atol = 1e-2 rtol, as in A04, where atol = 1e-6 rtol makes IDA fail
-  # (IDA_CONV_FAIL) in the first steps.
-  - {{type: dynamics, t0: -{eps}, t_end: 10, output_step: {eps}, rtol: 1.0e-13, atol: 1.0e-15, newton_convergence: 0.001}}
+  # Samples at t = 0, 0.01, ... rtol 1e-13 gives s to about 2e-9 and H to 3e-9 (rtol 1e-11: 1e-6
+  # and 1.3e-6; the energy dissipated in 10 s, 3.1e-3 J, needs rtol 1e-12 or less). atol = 1e-2
+  # rtol, as in A04, where atol = 1e-6 rtol makes IDA fail (IDA_CONV_FAIL) in the first steps.
+  - {{type: dynamics, t0: 0, t_end: 10, output_step: 0.01, rtol: 1.0e-13, atol: 1.0e-15, newton_convergence: 0.001,
+     initial_velocities: {{phi: {fmt(omega0)}, s: 0, bA: 0, bB: 0}}}}
 """
 
 
 def repro_end_step():
-    """Engine bug reproducer: the last step, shortened by IDA's stop time to land on t_end, fails."""
-    text = a02_scene(40, 0.6, penalty=False)
+    """Regression scene: the last step, shortened by IDA's stop time to land on t_end, failed."""
+    text = a02_scene(40, REPRO_T_END, penalty=False)
     text = text.replace("rtol: 1.0e-10, atol: 1.0e-13", "rtol: 1.0e-11, atol: 1.0e-13")
     text = text.replace("name: A02_n_four_bar_N40", "name: repro_end_step_conv_fail")
-    head = """# Reproducer (mbdae engine bug, found with the IFToMM A02 scenes; generated by make_scenes.py):
-# the A02 N = 40 four-bar to t_end = 0.60 s at rtol 1e-11, atol 1e-13. mbdae (commit e4111d1
-# with the working tree of 2026-11-22 02:10) fails on the last step, which IDA shortens to land
-# on the stop time t_end:
-#   build/mbdae run verification/iftomm/scenes/repro_end_step_conv_fail.yaml --out /tmp/repro
-#   -> IDA failed at t = 0.599872 with step size 4.9e-10 (IDA_CONV_FAIL)
-# t_end = 0.59 or 0.61 completes; 0.40, 0.52, 0.55, 0.65, ... fail the same way, just before
-# t_end. The same integration with the stop time at t_end removed (IDA steps past t_end, the
-# last sample interpolated; core/ida_driver.cpp patched in a scratch copy) completes in all five
-# cases tried. The state is 0.12 s away from the singular configuration (0.72 s): this is not
-# that limitation.
+    return REPRO_HEAD + text
+
+
+REPRO_T_END = 0.48
+REPRO_HEAD = """# Regression scene of a fixed engine bug (found with the IFToMM A02 scenes; generated by
+# make_scenes.py): the A02 N = 40 four-bar at index 3 to t_end = 0.48 s at rtol 1e-11, atol 1e-13,
+# newton_convergence 0.001. Until commit bec1a5d mbdae failed on the last step, which IDA shortened
+# to land on the stop time t_end (IDA failed at t = 0.479828 with step size 6.55383e-10,
+# IDA_CONV_FAIL); of t_end = 0.30, 0.31, ..., 0.70 s, 0.48, 0.58, 0.62, 0.64, 0.68, 0.69 and 0.70
+# failed, the others completed; so did newton_convergence 0.01 or 0.33 and the penalty
+# formulation. Since bec1a5d the end of a run is a stop time only where the inputs have a
+# breakpoint there (core/ida_driver.cpp): the last step goes past t_end and the end is
+# interpolated; all of those end times complete (measured 2026-11-22), and
+# EngineFindings.LastStepToTheEndTime (verification/iftomm/iftomm_test.cpp) runs this scene.
 """
-    return head + text
 
 
 def main():

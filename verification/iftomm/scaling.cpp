@@ -7,7 +7,8 @@
 // peak resident memory (getrusage ru_maxrss) is that of the one size. The model is built in code
 // (formulation/model.h structs, the geometry of verification/iftomm/scenes/A02_*.yaml: 2N+1
 // slender rods of 1 m and 1 kg, every pin a spatial revolute about z, N revolute loop cuts), the
-// initial state set directly (theta = pi/2, theta' = -1 rad/s), and a fixed simulation run:
+// initial state theta = pi/2 with the rate theta' = -1 rad/s of crank 0 given as a scene's
+// initial_velocities gives it (solve_initial_velocities), and a fixed simulation run:
 // 0.5 s (before the first singular configuration at 0.72 s), rtol 1e-6, atol 1e-9, Newton
 // convergence coefficient 0.33 (IDA's default), no output samples but the end.
 //
@@ -40,6 +41,7 @@
 #include "core/klu_solver.h"
 #include "formulation/augmented_solver.h"
 #include "formulation/index3_dae.h"
+#include "formulation/initial_velocities.h"
 #include "formulation/mechanics.h"
 #include "formulation/redundancy.h"
 #include "formulation/system.h"
@@ -197,33 +199,17 @@ Result run_one(int n) {
   res.redundant = static_cast<long>(rr.redundant.size());
   res.equations = sys.num_constraint_rows();
 
-  // Initial velocities of theta' = -1 rad/s: the cranks turn about their pivots (i, 0, 0), the
-  // couplers translate with the crank tips. Rates from the assembled positions: r' = w x (r - A),
-  // Euler parameters p' = 1/2 (0, w) * p (quaternion product, w = theta' e_z in world axes).
-  // Index3Dae's velocity projection then makes them consistent to rounding.
+  // Initial velocities as a scene's initial_velocities gives them (formulation/initial_velocities.h):
+  // the rate theta' = -1 rad/s of crank 0, the rest from the constraints (timed with the
+  // consistent start). Index3Dae's velocity projection then makes them consistent to rounding.
   Index3Dae dae(sys, 1.0 / (1e-3 * 1e-3));  // run_scene's automatic scale: mean mass / (1e-3 s)^2
   dae.modes = initial_modes(sys, q.data(), 0.0);
   res.unknowns = dae.size();
   res.jac_nnz = dae.jacobian_pattern().nnz();
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(q.begin(), q.end(), y.begin());
-  const Vec3 tip_rate = rate0 * Vec3::UnitZ().cross(Vec3(std::cos(theta0), std::sin(theta0), 0));
-  for (int b = 0; b < sys.num_bodies(); ++b) {
-    const std::string& name = sys.bodies[b].name;
-    double* v = y.data() + sys.nq() + 7 * b;
-    const double* p = q.data() + 7 * b + 3;
-    if (name.rfind("crank", 0) == 0) {
-      const Vec3 arm = Vec3(q[7 * b], q[7 * b + 1], q[7 * b + 2]) - Vec3(std::stod(name.substr(5)), 0, 0);
-      const Vec3 rd = rate0 * Vec3::UnitZ().cross(arm);
-      const double w = rate0;
-      const double pd[4] = {-0.5 * w * p[3], -0.5 * w * p[2], 0.5 * w * p[1], 0.5 * w * p[0]};
-      for (int k = 0; k < 3; ++k) v[k] = rd[k];
-      for (int k = 0; k < 4; ++k) v[3 + k] = pd[k];
-    } else {
-      for (int k = 0; k < 3; ++k) v[k] = tip_rate[k];
-    }
-  }
   c0 = cpu_now();
+  solve_initial_velocities(sys, y.data(), 0.0, {{sys.coordinate_index("th0"), rate0}}, y.data() + sys.nq());
   dae.consistent_initial_values(0.0, y, yp);
   res.init_s = cpu_now() - c0;
 
