@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "formulation/mechanics.h"
+#include "formulation/normalized_jacobian.h"
 
 namespace mbdae {
 
@@ -14,43 +15,14 @@ RedundancyReport find_redundant_constraints(System& sys, const double* q, double
                                             double tolerance) {
   RedundancyReport report;
   const std::vector<int> off = constraint_offsets(sys);
-  const int nc = off.back(), nq = sys.nq();
+  const int nc = off.back();
   report.equations = nc;
   if (nc == 0) return report;
 
   // A = Phi_q^T (nq x nc), one column per equation, normalized.
   cholmod_common cc;
   cholmod_l_start(&cc);
-  std::vector<std::vector<std::pair<int, double>>> cols(nc);
-  Row14 rows[3];
-  for (size_t k = 0; k < sys.constraints.size(); ++k) {
-    const Constraint& c = sys.constraints[k];
-    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
-    for (int r = 0; r < c.rows(); ++r) {
-      double norm = rows[r].norm();
-      for (int l = 0; l < 14; ++l) {
-        const int b = l < 7 ? c.bi : c.bj;
-        if (b < 0 || rows[r](l) == 0.0) continue;
-        cols[off[k] + r].push_back({7 * b + l % 7, norm > 0 ? rows[r](l) / norm : 0.0});
-      }
-    }
-  }
-  size_t nnz = 0;
-  for (auto& col : cols) nnz += col.size();
-  cholmod_sparse* a = cholmod_l_allocate_sparse(nq, nc, nnz, 1, 1, 0, CHOLMOD_REAL, &cc);
-  auto* ap = static_cast<SuiteSparse_long*>(a->p);
-  auto* ai = static_cast<SuiteSparse_long*>(a->i);
-  auto* ax = static_cast<double*>(a->x);
-  size_t pos = 0;
-  for (int j = 0; j < nc; ++j) {
-    ap[j] = pos;
-    std::sort(cols[j].begin(), cols[j].end());
-    for (auto& [i, v] : cols[j]) {
-      ai[pos] = i;
-      ax[pos++] = v;
-    }
-  }
-  ap[nc] = pos;
+  cholmod_sparse* a = normalized_constraint_jacobian_transpose(sys, q, &cc);
 
   // QR in the natural column order; dead columns (norm below tol when reached) are redundant.
   cholmod_sparse* r_factor = nullptr;
