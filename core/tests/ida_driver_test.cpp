@@ -1,0 +1,166 @@
+// The IDA driver (core/ida_driver.cpp) on a small index-1 DAE with a closed-form solution:
+//   F1 = y1' + y1 - u(t) = 0      (differential, in the error test)
+//   F2 = y2 - 2 y1       = 0      (algebraic, out of it, like the multibody velocities)
+// u = 0, or a unit step at t = 0.5 declared as a breakpoint. Then
+//   y1 = e^-t  (u = 0),   y1 = 1 + (e^-0.5 - 1) e^-(t - 0.5) after the step,   y2 = 2 y1.
+// Checked: output samples and the final state against the solution, the end of the run reached
+// exactly (whether or not it is a breakpoint), breakpoints hit exactly with a restart, an event
+// located by root finding.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/ida_driver.h"
+
+namespace mbdae {
+namespace {
+
+class DecayProblem : public DaeProblem {
+ public:
+  bool step_input = false;       // unit step of u at t = 0.5
+  bool end_breakpoint = false;   // declare t = 2 a breakpoint too
+  double switch_level = -1;      // > 0: event where y1 crosses it
+  std::vector<double> restart_times;
+  std::vector<bool> restart_was_event;
+
+  DecayProblem() {
+    pattern_.rows = pattern_.cols = 2;
+    pattern_.colptr = {0, 2, 3};
+    pattern_.rowind = {0, 1, 1};
+  }
+  int size() const override { return 2; }
+  const CscPattern& jacobian_pattern() override { return pattern_; }
+  double u(double t) const {
+    // Left limit at the end of a segment: the jump belongs to the next one.
+    const double tt = t < segment_end_ ? t : std::nextafter(segment_end_, 0.0);
+    return step_input && tt >= 0.5 ? 1.0 : 0.0;
+  }
+  int residual(double t, const double* y, const double* yp, double* r) override {
+    r[0] = yp[0] + y[0] - u(t);
+    r[1] = y[1] - 2 * y[0];
+    return 0;
+  }
+  int jacobian(double, double cj, const double*, const double*, double* v) override {
+    v[0] = 1 + cj;  // (0, 0)
+    v[1] = -2;      // (1, 0)
+    v[2] = 1;       // (1, 1)
+    return 0;
+  }
+  void error_test_mask(double* id) const override {
+    id[0] = 1;
+    id[1] = 0;
+  }
+  int num_switches() const override { return switch_level > 0 ? 1 : 0; }
+  void switches(double, const double* y, double* g) override { g[0] = y[0] - switch_level; }
+  void restart(double t, double* y, double* yp, const int* roots) override {
+    restart_times.push_back(t);
+    restart_was_event.push_back(roots != nullptr);
+    y[1] = 2 * y[0];
+    yp[0] = -y[0] + u(t);
+    yp[1] = 2 * yp[0];
+  }
+  std::vector<double> breakpoints() const override {
+    std::vector<double> b;
+    if (step_input) b.push_back(0.5);
+    if (end_breakpoint) b.push_back(2.0);
+    return b;
+  }
+  void set_segment(double, double t_end) override { segment_end_ = t_end; }
+
+  double exact(double t) const {
+    if (!step_input || t <= 0.5) return std::exp(-t);
+    return 1 + (std::exp(-0.5) - 1) * std::exp(-(t - 0.5));
+  }
+
+ private:
+  CscPattern pattern_;
+  double segment_end_ = 1e300;
+};
+
+struct Sample {
+  double t, y1, y2;
+};
+
+IdaStats run(DecayProblem& p, std::vector<Sample>& samples, std::vector<double>& y) {
+  IdaOptions o;
+  o.t0 = 0;
+  o.t1 = 2;
+  o.rtol = 1e-10;
+  o.atol = 1e-12;
+  o.output_step = 0.1;
+  y = {1.0, 2.0};
+  std::vector<double> yp = {-1.0, -2.0};
+  return integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
+    samples.push_back({t, yy[0], yy[1]});
+    return true;
+  });
+}
+
+void expect_follows_solution(const DecayProblem& p, const std::vector<Sample>& samples,
+                             const std::vector<double>& y, const IdaStats& st) {
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(samples.size(), 21u);
+  double worst = 0;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    EXPECT_NEAR(samples[k].t, 0.1 * k, 1e-15);
+    worst = std::fmax(worst, std::fabs(samples[k].y1 - p.exact(samples[k].t)));
+    EXPECT_NEAR(samples[k].y2, 2 * samples[k].y1, 1e-9);
+  }
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_EQ(samples.back().t, 2.0);
+  EXPECT_EQ(st.t_reached, 2.0);
+  EXPECT_NEAR(y[0], p.exact(2.0), 1e-8);  // the final state is the state at t1
+  EXPECT_NEAR(y[1], 2 * y[0], 1e-9);
+}
+
+TEST(IdaDriver, DecayFollowsTheSolutionToTheEnd) {
+  DecayProblem p;
+  std::vector<Sample> s;
+  std::vector<double> y;
+  const IdaStats st = run(p, s, y);
+  expect_follows_solution(p, s, y, st);
+  EXPECT_TRUE(st.breakpoint_times.empty());
+  EXPECT_TRUE(p.restart_times.empty());
+}
+
+TEST(IdaDriver, BreakpointIsHitExactlyAndRestarted) {
+  DecayProblem p;
+  p.step_input = true;
+  std::vector<Sample> s;
+  std::vector<double> y;
+  const IdaStats st = run(p, s, y);
+  expect_follows_solution(p, s, y, st);
+  ASSERT_EQ(st.breakpoint_times.size(), 1u);
+  EXPECT_EQ(st.breakpoint_times[0], 0.5);
+  ASSERT_EQ(p.restart_times.size(), 1u);
+  EXPECT_EQ(p.restart_times[0], 0.5);
+  EXPECT_FALSE(p.restart_was_event[0]);
+}
+
+TEST(IdaDriver, EndAtABreakpointIsAStopTime) {
+  DecayProblem p;
+  p.step_input = true;
+  p.end_breakpoint = true;
+  std::vector<Sample> s;
+  std::vector<double> y;
+  const IdaStats st = run(p, s, y);
+  expect_follows_solution(p, s, y, st);
+  EXPECT_EQ(st.breakpoint_times.size(), 1u);  // the end is no restart
+}
+
+TEST(IdaDriver, EventIsLocatedAndRestarted) {
+  DecayProblem p;
+  p.switch_level = 0.3;  // e^-t = 0.3 at t = ln(10/3)
+  std::vector<Sample> s;
+  std::vector<double> y;
+  const IdaStats st = run(p, s, y);
+  expect_follows_solution(p, s, y, st);
+  ASSERT_EQ(st.event_times.size(), 1u);
+  EXPECT_NEAR(st.event_times[0], std::log(10.0 / 3.0), 1e-9);
+  ASSERT_EQ(p.restart_times.size(), 1u);
+  EXPECT_TRUE(p.restart_was_event[0]);
+}
+
+}  // namespace
+}  // namespace mbdae
