@@ -90,13 +90,8 @@ TEST(Formulations, GglNewtonMatrixIsExact) {
   const State st = random_state(sys, 3);
   const int n = dae.size(), nq = sys.nq(), nc = sys.num_constraint_rows();
   ASSERT_EQ(n, 2 * nq + 2 * nc);
-  std::vector<double> y(n), yp(n, 0.0);
-  std::copy(st.q.begin(), st.q.end(), y.begin());
-  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
-  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
-  std::copy(st.mu.begin(), st.mu.end(), y.begin() + 2 * nq + nc);
-  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
-  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  std::vector<double> y, yp;
+  testing::dae_vectors(st, n, true, y, yp);
   const double cj = 37.0, t = 0.3;
   // Wheel in contact (its force derivatives in the matrix).
   for (auto& m : dae.modes) m = 1;
@@ -118,12 +113,8 @@ TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
   const State st = random_state(sys, 3);
   const int n = dae.size(), nq = sys.nq(), nc = sys.num_constraint_rows();
   const std::vector<int> off = constraint_offsets(sys);
-  std::vector<double> y(n), yp(n, 0.0);
-  std::copy(st.q.begin(), st.q.end(), y.begin());
-  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
-  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
-  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
-  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  std::vector<double> y, yp;
+  testing::dae_vectors(st, n, false, y, yp);
   const double cj = 37.0, t = 0.3;
   for (auto& m : dae.modes) m = 1;
   for (auto& m : exact.modes) m = 1;
@@ -176,12 +167,8 @@ TEST(Formulations, PenaltyResidualAndNewtonMatrix) {
   EXPECT_EQ(plain.inverse_penalty(), 0.0);
   const State st = random_state(sys, 5);
   const int n = pen.size(), nq = sys.nq(), nc = sys.num_constraint_rows();
-  std::vector<double> y(n), yp(n, 0.0);
-  std::copy(st.q.begin(), st.q.end(), y.begin());
-  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
-  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
-  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
-  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  std::vector<double> y, yp;
+  testing::dae_vectors(st, n, false, y, yp);
   const double cj = 37.0, t = 0.3;
   for (auto& m : pen.modes) m = 1;
   for (auto& m : plain.modes) m = 1;

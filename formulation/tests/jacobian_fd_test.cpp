@@ -151,13 +151,9 @@ TEST(JacobianFd, Index3NewtonMatrix) {
   const System sys = build_system(all_types_model());
   Index3Dae dae(sys, 7.0);
   const RandomState st = random_state(sys, 3);
-  const int n = dae.size(), nq = sys.nq();
-  std::vector<double> y(n), yp(n);
-  std::copy(st.q.begin(), st.q.end(), y.begin());
-  std::copy(st.v.begin(), st.v.end(), y.begin() + nq);
-  std::copy(st.lambda.begin(), st.lambda.end(), y.begin() + 2 * nq);
-  for (int i = 0; i < nq; ++i) yp[i] = st.v[i] + 0.1;
-  std::copy(st.a.begin(), st.a.end(), yp.begin() + nq);
+  const int n = dae.size();
+  std::vector<double> y, yp;
+  testing::dae_vectors(st, n, false, y, yp);
   const double cj = 37.0, t = 0.3;
   const CscPattern& p = dae.jacobian_pattern();
   std::vector<double> values(p.nnz());

@@ -1,6 +1,7 @@
 // Small models shared by the formulation tests, built in code (no scene files).
 #pragma once
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -179,6 +180,21 @@ inline RandomState random_state(const System& sys, unsigned seed) {
   for (auto& l : s.lambda) l = 10 * u(gen);
   for (auto& m : s.mu) m = 0.1 * u(gen);
   return s;
+}
+
+// The DAE vectors of a random state, n unknowns: y = [q, v, lambda (, mu with_mu)], rest 0;
+// y' = [v + 0.1, a, 0 ...] (q' differs from v, so the rows F1 are exercised).
+inline void dae_vectors(const RandomState& s, int n, bool with_mu, std::vector<double>& y,
+                        std::vector<double>& yp) {
+  const int nq = static_cast<int>(s.q.size()), nc = static_cast<int>(s.lambda.size());
+  y.assign(n, 0.0);
+  yp.assign(n, 0.0);
+  std::copy(s.q.begin(), s.q.end(), y.begin());
+  std::copy(s.v.begin(), s.v.end(), y.begin() + nq);
+  std::copy(s.lambda.begin(), s.lambda.end(), y.begin() + 2 * nq);
+  if (with_mu) std::copy(s.mu.begin(), s.mu.end(), y.begin() + 2 * nq + nc);
+  for (int i = 0; i < nq; ++i) yp[i] = s.v[i] + 0.1;
+  std::copy(s.a.begin(), s.a.end(), yp.begin() + nq);
 }
 
 // Crank (length 1) and rocker (length 1) on revolute joints about z at (0,0,0) and (2,0,0),
