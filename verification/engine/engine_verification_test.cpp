@@ -52,15 +52,34 @@ std::string scene_path(const std::string& name) {
   return std::string(MBDAE_SOURCE_DIR) + "/verification/engine/scenes/" + name;
 }
 
-mbdae::RunOutcome run(const std::string& name) {
+// Rows kept, nothing printed; `tight`: kTightRtol and kTightAtol instead of the scene's.
+mbdae::RunOptions test_options(bool tight) {
   mbdae::RunOptions o;
-  o.out_dir = "";
   o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  o.rtol = kTightRtol;
-  o.atol = kTightAtol;
-  return mbdae::run_scene(mbdae::load_scene(scene_path(name)), o);
+  if (tight) {
+    o.rtol = kTightRtol;
+    o.atol = kTightAtol;
+  }
+  return o;
+}
+
+mbdae::RunOutcome run(const std::string& name) {
+  return mbdae::run_scene(mbdae::load_scene(scene_path(name)), test_options(true));
+}
+
+// The text of a scene of verification/engine/scenes, to run modified with run_text().
+std::string scene_text(const std::string& name) {
+  std::ifstream in(scene_path(name));
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A modified scene `text`, read as if it were the file `name` (for its relative paths).
+mbdae::RunOutcome run_text(const std::string& text, const std::string& name, bool tight) {
+  return mbdae::run_scene(mbdae::load_scene_text(text, scene_path(name)), test_options(tight));
 }
 
 std::vector<double> series(const mbdae::RunOutcome& r, const std::string& name) {
@@ -218,10 +237,7 @@ TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
 TEST(CompoundPendulum, InitialVelocityGivesTheSameSwing) {
   const CompoundPendulumReference ref = compound_pendulum_reference();
   const double rate0 = std::sqrt(2 * ref.stiffness * (1 - std::cos(ref.amplitude)) / ref.i_hinge);
-  std::ifstream in(scene_path("compound_pendulum.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string scene = text.str();
+  std::string scene = scene_text("compound_pendulum.yaml");
   const std::string start = "theta: {initial_deg: 80.556045219583467}";
   const size_t at = scene.find(start);
   ASSERT_NE(at, std::string::npos);
@@ -233,13 +249,7 @@ TEST(CompoundPendulum, InitialVelocityGivesTheSameSwing) {
   ASSERT_NE(st, std::string::npos);
   std::snprintf(buf, sizeof buf, "{type: dynamics, initial_velocities: {theta: %.17g}, ", rate0);
   scene.replace(st, step.size(), buf);
-  mbdae::RunOptions o;
-  o.keep_rows = true;
-  o.verbose = false;
-  o.progress = false;
-  o.rtol = kTightRtol;
-  o.atol = kTightAtol;
-  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("compound_pendulum.yaml")), o);
+  const mbdae::RunOutcome r = run_text(scene, "compound_pendulum.yaml", true);
   expect_ran_to(r, 10.5);
   const auto theta = series(r, "theta"), rate = series(r, "theta_rate");
   EXPECT_NEAR(theta[0], ref.theta_eq, 1e-12);
@@ -259,10 +269,7 @@ TEST(CompoundPendulum, InitialVelocityGivesTheSameSwing) {
 // velocity (one degree of freedom), x' = -r w sin(phi) - r^2 w sin(phi) cos(phi) / sqrt(l^2 -
 // r^2 sin^2(phi)); a rate of x as well over-determines the motion and is refused.
 std::string free_slider_crank(const std::string& rates) {
-  std::ifstream in(scene_path("slider_crank.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string scene = text.str();
+  std::string scene = scene_text("slider_crank.yaml");
   const std::string driven = "phi: {initial: 0, mode: driven, drive: {type: polynomial, coefficients: [0, 6.283185307179586]}}";
   const size_t at = scene.find(driven);
   if (at == std::string::npos) return "";
@@ -277,11 +284,7 @@ std::string free_slider_crank(const std::string& rates) {
 TEST(SliderCrank, InitialCrankRateSetsThePistonRate) {
   const std::string scene = free_slider_crank("phi: 6.283185307179586");
   ASSERT_FALSE(scene.empty());
-  mbdae::RunOptions o;
-  o.keep_rows = true;
-  o.verbose = false;
-  o.progress = false;
-  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("slider_crank.yaml")), o);
+  const mbdae::RunOutcome r = run_text(scene, "slider_crank.yaml", false);
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
   const double rr = 0.1, l = 0.35, w = 2 * kPi, phi = 0.6;
   const double sn = std::sin(phi), cs = std::cos(phi);
@@ -296,10 +299,7 @@ TEST(SliderCrank, InitialCrankRateSetsThePistonRate) {
 TEST(SliderCrank, InitialRatesBeyondTheDegreesOfFreedomAreRefused) {
   const std::string scene = free_slider_crank("phi: 6.283185307179586, x: 1.0");
   ASSERT_FALSE(scene.empty());
-  mbdae::RunOptions o;
-  o.verbose = false;
-  o.progress = false;
-  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene_text(scene, scene_path("slider_crank.yaml")), o);
+  const mbdae::RunOutcome r = run_text(scene, "slider_crank.yaml", false);
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.summary["status"], "inconsistent_initial_velocities") << r.summary.dump(2);
   const std::string message = r.summary.value("message", "");
