@@ -694,12 +694,10 @@ struct Loader {
         error(iv, "initial_velocities", "expected a mapping of coordinate names to rates, got " + describe(iv));
       } else {
         for (const auto& kv : iv) {
-          if (!kv.first.IsScalar()) {
-            error(kv.first, "initial_velocities", "expected a coordinate name, got " + describe(kv.first));
-            continue;
-          }
-          const std::string field = "initial_velocities." + kv.first.Scalar();
-          if (const auto x = to_number(kv.second, field)) s.initial_velocities.emplace_back(kv.first.Scalar(), *x);
+          const auto cname = key_of(kv.first, "initial_velocities");
+          if (!cname) continue;
+          if (const auto x = to_number(kv.second, "initial_velocities." + *cname))
+            s.initial_velocities.emplace_back(*cname, *x);
         }
       }
     }
