@@ -172,9 +172,14 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   }
   std::vector<int> roots(std::max(1, nsw));
 
+  // Breakpoints inside the span end segments. One at t1 makes the end a stop time (see
+  // next_stop below).
   std::vector<double> bps;
-  for (double b : problem.breakpoints())
+  bool end_is_breakpoint = false;
+  for (double b : problem.breakpoints()) {
     if (b > o.t0 && b < o.t1) bps.push_back(b);
+    if (std::fabs(b - o.t1) <= 1e-12 * std::max(1.0, std::fabs(o.t1))) end_is_breakpoint = true;
+  }
   std::sort(bps.begin(), bps.end());
 
   // Output samples.
@@ -211,9 +216,6 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   // last knot): elsewhere the last step may go past t1 and the end is interpolated like every
   // sample. A last step shortened to land on t1 can fail at index 3, where the Newton matrix's
   // condition grows as 1/h^2 (verification/iftomm: EngineFindings.LastStepToTheEndTime).
-  bool end_is_breakpoint = false;
-  for (double b : problem.breakpoints())
-    if (std::fabs(b - o.t1) <= 1e-12 * std::max(1.0, std::fabs(o.t1))) end_is_breakpoint = true;
   const double t_beyond = o.t1 + (o.t1 - o.t0);
   auto next_stop = [&] {
     return next_bp < bps.size() ? bps[next_bp] : end_is_breakpoint ? o.t1 : t_beyond;
