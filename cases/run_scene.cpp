@@ -415,10 +415,9 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
           // why the run cannot go on (a drive past the mechanism's travel, a dead centre).
           std::string message = st.message;
           if (st.status == "integration_failed") {
-            AugmentedSolver probe(sys);
             const FailureDiagnosis d = diagnose_integration_failure(
                 sys, dae.modes, column_sensors, q.data(), y.data() + sys.nq(), st.t_reached,
-                dae.input_time(st.t_reached), probe.constraint_condition(q.data()), st.message);
+                dae.input_time(st.t_reached), dae.augmented().constraint_condition(q.data()), st.message);
             for (const auto& [key, value] : d.details.items()) js[key] = value;
             if (d.singular) {
               js["solver_message"] = st.message;
