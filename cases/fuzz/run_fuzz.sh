@@ -6,7 +6,7 @@
 #
 # SECONDS defaults to 60. Exit status 0 if nothing was found; otherwise libFuzzer's status, with
 # the reproducer in the artifact folder (printed at the end). Environment:
-#   MBDAE_FUZZ_BUILD      build folder (default: build-fuzz at the top of the repository)
+#   MBDAE_FUZZ_BUILD      build folder (default: build/fuzz)
 #   MBDAE_FUZZ_ARTIFACTS  where crash-*, timeout-*, leak-* files go (default: BUILD/artifacts)
 #   MBDAE_FUZZ_STRICT=1   also stop when a scene passes validation but build_system rejects it
 #   MBDAE_FUZZ_JOBS       parallel compile jobs (default: nproc)
@@ -22,7 +22,7 @@ fi
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/../.." && pwd)
-build=${MBDAE_FUZZ_BUILD:-$root/build-fuzz}
+build=${MBDAE_FUZZ_BUILD:-$root/build/fuzz}
 artifacts=${MBDAE_FUZZ_ARTIFACTS:-$build/artifacts}
 cxx=${CXX_FUZZ:-clang++-14}
 jobs=${MBDAE_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}

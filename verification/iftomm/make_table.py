@@ -4,7 +4,7 @@ docs/iftomm-benchmarks.md: per problem the quantity, the reference and its sourc
 the error, the error measure, whether the tolerance is met and the CPU time (summary.json
 cpu_seconds of the dynamics step).
 
-  verification/iftomm/make_table.py [--mbdae build/mbdae] [--out out/iftomm] [--doc docs/iftomm-benchmarks.md]
+  verification/iftomm/make_table.py [--mbdae build/mbdae] [--out build/iftomm] [--doc docs/iftomm-benchmarks.md]
 
 The references are computed here, independently of mbdae: A01 exactly (Jacobi sn by the AGM),
 A02 by RK4 on the one-degree-of-freedom parallelogram equation, A04 and A05 from the tables of
@@ -540,7 +540,7 @@ NOTES = """
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--mbdae", default=os.path.join(ROOT, "build", "mbdae"))
-    ap.add_argument("--out", default=os.path.join(ROOT, "out", "iftomm"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "build", "iftomm"))
     ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "iftomm-benchmarks.md"))
     args = ap.parse_args()
     if not os.path.exists(args.mbdae):

@@ -10,7 +10,7 @@
 #            910af29, see docs/extreme-cases.md). Without --long their last stored results are
 #            kept in the table.
 #   --only   run only these cases (the table is still rebuilt from every stored result).
-# Environment: BUILD (default build/), OUT (raw run folders, default out/studies/extreme).
+# Environment: BUILD (default build/), OUT (raw run folders, default BUILD/studies/extreme).
 # Per-case results: docs/studies/extreme/NAME.json. Exit code 0 unless a case's outcome could not
 # be collected (a case that fails the way its documentation says is not an error of this script).
 set -uo pipefail
@@ -18,7 +18,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 build="${BUILD:-$root/build}"
 mbdae="$build/mbdae"
-out="${OUT:-$root/out/studies/extreme}"
+out="${OUT:-$build/studies/extreme}"
 results="$root/docs/studies/extreme"
 doc="$root/docs/extreme-cases.md"
 tables="$root/verification/studies/make_tables.py"
