@@ -35,6 +35,9 @@ int main(int argc, char** argv) {
   const bool check_only = std::strcmp(argv[1], "check") == 0;
   const std::string scene_path = argv[2];
   mbdae::RunOptions opt;
+  opt.verbose = true;
+  opt.progress = true;
+  opt.keep_rows = false;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc) {

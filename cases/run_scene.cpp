@@ -88,9 +88,27 @@ double automatic_constraint_scale(const System& sys, const AnalysisStep& step) {
   return m / (h * h);
 }
 
+std::string sensor_unit(const System& sys, const Sensor& s) {
+  using T = SensorSpec::Type;
+  switch (s.type) {
+    case T::kPosition: return "m";
+    case T::kVelocity: return "m/s";
+    case T::kAcceleration: return "m/s^2";
+    case T::kAxis: return "1";
+    case T::kCoordinate: return sys.coordinates[s.target].function.rotation ? "rad" : "m";
+    case T::kCoordinateRate: return sys.coordinates[s.target].function.rotation ? "rad/s" : "m/s";
+    case T::kForceLength: return "m";
+    case T::kForceValue: return "N";
+    case T::kKineticEnergy:
+    case T::kPotentialEnergy: return "J";
+    case T::kExpression: return "";
+  }
+  return "";
+}
+
 }  // namespace
 
-RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
+RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vector<Sink*>& sinks) {
   RunOutcome out;
   json& summary = out.summary;
   summary["scene"] = scene.file;
@@ -158,7 +176,11 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
     }
   }
   out.columns = {"t"};
-  for (int k : column_sensors) out.columns.push_back(sys.sensors[k].name);
+  out.units = {"s"};
+  for (int k : column_sensors) {
+    out.columns.push_back(sys.sensors[k].name);
+    out.units.push_back(sensor_unit(sys, sys.sensors[k]));
+  }
 
   auto fail = [&](const std::string& status, const std::string& message, json step) {
     step["status"] = status;
@@ -335,6 +357,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
         }
         CsvWriter csv;
         if (!opt.out_dir.empty()) csv.open(opt.out_dir + "/results.csv", out.columns);
+        const RunInfo info{&scene, &sys, &step, &out.columns, &out.units};
+        for (Sink* s : sinks) s->begin(info);
         std::vector<double> qo, vo, ao, sensors(sys.sensors.size()), row(out.columns.size());
         double max_output_violation = 0;
         std::vector<int> quiet;
@@ -356,6 +380,12 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt) {
             if (++rows % 256 == 0) csv.flush();
           }
           if (opt.keep_rows) out.rows.push_back(row);
+          if (!sinks.empty()) {
+            const Sample sample{t, row.data(), qo.data(), vo.data(), ao.empty() ? nullptr : ao.data(), &dae.modes,
+                                dae.input_time(t)};
+            for (Sink* s : sinks) s->sample(sample);
+          }
+          if (opt.stop && opt.stop->load(std::memory_order_relaxed)) return false;
           if (quiet_ref.empty()) for (int k : quiet) quiet_ref.push_back(sensors[k]);
           if (t < step.quiet_until)
             for (size_t k = 0; k < quiet.size(); ++k)

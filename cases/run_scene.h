@@ -8,28 +8,18 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/scene.h"
+#include "cases/mbdae.h"
 
 namespace mbdae {
-
-struct RunOptions {
-  std::string out_dir;        // empty: write nothing
-  double rtol = 0, atol = 0;  // > 0: override the scene's tolerances
-  double output_step = 0;     // > 0: overrides the dynamics steps' output_step (sample spacing)
-  bool progress = true;       // progress line on stderr for runs over a second
-  bool keep_rows = false;     // keep results in memory (tests)
-  bool verbose = true;        // print assembly / equilibrium results on stdout
-  std::string formulation;    // non-empty: overrides the steps' formulation (index3, index2-ggl, index1, penalty)
-};
 
 struct RunOutcome {
   int exit_code = 0;  // 0 ok, 3 solve failure
   nlohmann::ordered_json summary;
-  std::vector<std::string> columns;
+  std::vector<std::string> columns, units;
   std::vector<std::vector<double>> rows;
   std::vector<double> q;  // final positions
 };
 
-RunOutcome run_scene(const Scene& scene, const RunOptions& options);
+RunOutcome run_scene(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks = {});
 
 }  // namespace mbdae
