@@ -151,3 +151,19 @@ def test_a_worker_killed_during_the_sweep_does_not_lose_its_task(client, tmp_pat
     for i, run in enumerate(params):
         alone = mbdae.load(STEP).run(**run)
         assert table["travel"][i] == np.max(np.abs(alone["wheel_z"] - alone["wheel_z"][0]))
+
+
+def test_work_precision_table(client, tmp_path):
+    scene = mbdae.load(STEP)
+    reference = scene.run(formulation="index3", rtol=1e-11, atol=1e-15)
+    table = mbdae.work_precision(scene, ["index3", "index1"], [1e-5, 1e-8], columns=["wheel_z"], reference=reference,
+                                 out=tmp_path, client=client)
+    assert list(table["formulation"]) == ["index3", "index3", "index1", "index1"]
+    assert list(table["atol"]) == [1e-6 * tau for tau in (1e-5, 1e-8, 1e-5, 1e-8)] and (table["status"] == "ok").all()
+    for i, row in table.iterrows():
+        alone = scene.run(formulation=row["formulation"], rtol=row["rtol"], atol=row["atol"])
+        assert row["err_wheel_z"] == np.max(np.abs(alone["wheel_z"] - reference["wheel_z"]))
+        assert row["steps"] == alone.summary["steps"][-1]["statistics"]["steps"]
+    for f in ("index3", "index1"):  # tighter tolerance, smaller error, more steps
+        loose, tight = table[table["formulation"] == f].to_dict("records")
+        assert tight["err_wheel_z"] < 0.1 * loose["err_wheel_z"] and tight["steps"] > loose["steps"]
