@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 
+#include "cases/field_ranges.h"
 #include "cases/scene.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
@@ -33,7 +34,6 @@ namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr std::size_t kMaxFileBytes = 16u << 20;  // scene and model files
-constexpr double kMaxOutputRows = 1e8;
 
 using Fields = std::vector<std::string>;
 
@@ -69,12 +69,6 @@ std::string describe(const YAML::Node& n) {
   if (n.IsSequence()) return "a list of " + std::to_string(n.size());
   return quote(n.Scalar());
 }
-std::string format_number(double x) {
-  std::ostringstream os;
-  os << x;
-  return os.str();
-}
-
 struct Loader {
   std::string file;
   std::vector<SceneIssue>* issues;
@@ -747,16 +741,11 @@ struct Loader {
       error(at(n, "t_end"), "t_end", "the time span is empty (t_end " + format_number(s.t_end) +
                                          " must exceed t0 " + format_number(s.t0) + ")");
     if (integrates && (output_step || !has(n, "output_step"))) {
-      if (!(s.output_step > 0))
-        error(at(n, "output_step"), "output_step", "must be positive, got " + format_number(s.output_step));
-      else if (times_ok && s.t_end > s.t0 && (s.t_end - s.t0) / s.output_step > kMaxOutputRows)
-        error(at(n, "output_step"), "output_step", "too small: more than 1e8 output rows over [" +
-                                                       format_number(s.t0) + ", " + format_number(s.t_end) + "]");
+      const std::string why = output_step_range_error(s.output_step, times_ok ? s.t0 : 0, times_ok ? s.t_end : 0);
+      if (!why.empty()) error(at(n, "output_step"), "output_step", why);
     }
-    if (rtol && !(s.rtol >= 1e-14 && s.rtol <= 0.5))
-      error(n["rtol"], "rtol", "out of range [1e-14, 0.5], got " + format_number(s.rtol));
-    if (atol && !(s.atol > 0 && s.atol <= 1.0))
-      error(n["atol"], "atol", "out of range (0, 1], got " + format_number(s.atol));
+    if (rtol && !rtol_range_error(s.rtol).empty()) error(n["rtol"], "rtol", rtol_range_error(s.rtol));
+    if (atol && !atol_range_error(s.atol).empty()) error(n["atol"], "atol", atol_range_error(s.atol));
     if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
