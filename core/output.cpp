@@ -178,20 +178,20 @@ void prepare_output_folder(const std::string& dir, const std::vector<std::string
   auto refuse = [&](const std::string& why) {
     throw ModelError("", 0, "--out", "output folder '" + dir + "' " + why);
   };
-  std::error_code ec;
+  std::error_code ec, ec2;
   std::filesystem::create_directories(dir, ec);
-  if (!std::filesystem::is_directory(dir))
-    refuse("cannot be created" + (ec ? " (" + ec.message() + ")" : std::string()));
+  if (!std::filesystem::is_directory(dir, ec2))
+    refuse("cannot be created" + (ec || ec2 ? " (" + (ec ? ec : ec2).message() + ")" : std::string()));
   std::vector<std::string> probes = {".mbdae_write_test"};
   for (const auto& f : files) {
     const std::string path = dir + "/" + f;
-    if (std::filesystem::is_directory(path)) refuse("holds a folder named '" + f + "' where the file goes");
+    if (std::filesystem::is_directory(path, ec)) refuse("holds a folder named '" + f + "' where the file goes");
     probes.push_back(f + ".partial");
   }
   for (const auto& name : probes) {
     const std::string path = dir + "/" + name;
-    if (std::filesystem::is_directory(path)) refuse("holds a folder named '" + name + "' where a temporary file goes");
-    const bool existed = std::filesystem::exists(path);
+    if (std::filesystem::is_directory(path, ec)) refuse("holds a folder named '" + name + "' where a temporary file goes");
+    const bool existed = std::filesystem::exists(path, ec);
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0) refuse(name == probes[0] ? "is not writable (" + os_error(errno) + ")"
                                          : "cannot hold '" + name + "' (" + os_error(errno) + ")");
