@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <set>
+#include <unordered_map>
 
 #include "core/errors.h"
 #include "formulation/forces.h"
@@ -533,6 +534,9 @@ System build_system(const Model& model) {
   }
 
   // --- Forces --------------------------------------------------------------------------------
+  // Names looked up through hash maps, so that building stays linear in the number of names.
+  std::unordered_map<std::string, int> force_of, coordinate_of, sensor_of;
+  for (size_t k = 0; k < sys.coordinates.size(); ++k) coordinate_of.emplace(sys.coordinates[k].name, static_cast<int>(k));
   for (const auto& fs : model.forces) {
     Force f;
     f.type = fs.type;
@@ -566,7 +570,8 @@ System build_system(const Model& model) {
         f.parameters.push_back(it->second);
       }
     }
-    if (sys.force_index(f.name) >= 0) fail(fs.where, "name", "force '" + f.name + "' is defined twice");
+    if (!force_of.emplace(f.name, static_cast<int>(sys.forces.size())).second)
+      fail(fs.where, "name", "force '" + f.name + "' is defined twice");
     sys.forces.push_back(f);
   }
 
@@ -594,24 +599,22 @@ System build_system(const Model& model) {
       }
       case SensorSpec::Type::kCoordinate:
       case SensorSpec::Type::kCoordinateRate:
-        s.target = sys.coordinate_index(ss.target);
+        s.target = coordinate_of.count(ss.target) ? coordinate_of.at(ss.target) : -1;
         if (s.target < 0) fail(ss.where, "coordinate", "no coordinate named '" + ss.target + "'");
         break;
       case SensorSpec::Type::kForceLength:
       case SensorSpec::Type::kForceValue:
-        s.target = sys.force_index(ss.target);
+        s.target = force_of.count(ss.target) ? force_of.at(ss.target) : -1;
         if (s.target < 0) fail(ss.where, "force", "no force named '" + ss.target + "'");
         break;
       case SensorSpec::Type::kKineticEnergy:
       case SensorSpec::Type::kPotentialEnergy:
         break;  // whole-system quantities: nothing to resolve
       case SensorSpec::Type::kExpression: {
-        const int self = static_cast<int>(sys.sensors.size());
         try {
           s.expression = Expression::compile(ss.expression, [&](const std::string& n) {
-            for (int k = 0; k < self; ++k)
-              if (sys.sensors[k].name == n) return k;
-            return -1;
+            const auto it = sensor_of.find(n);  // the sensors listed before this one
+            return it == sensor_of.end() ? -1 : it->second;
           });
         } catch (const ExpressionError& e) {
           fail(ss.where, "expression", std::string(e.what()) + " (names must be sensors listed before)");
@@ -619,8 +622,8 @@ System build_system(const Model& model) {
         break;
       }
     }
-    for (const auto& other : sys.sensors)
-      if (other.name == s.name) fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
+    if (!sensor_of.emplace(s.name, static_cast<int>(sys.sensors.size())).second)
+      fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
     sys.sensors.push_back(s);
   }
   return sys;
