@@ -868,13 +868,28 @@ std::optional<std::string> read_text_file(const std::string& path, std::string& 
   return text;
 }
 
+// The line (1-based) of the '---' that starts the document whose content begins at 0-based line
+// `content` (the last '---' line up to it; the first '---' after line 1 if the document is empty).
+int second_document_line(const std::string& text, int content) {
+  std::istringstream in(text);
+  std::string line;
+  int found = 0;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (content >= 0 && k > content) break;
+    if (line.rfind("---", 0) == 0 && k > 0) {
+      found = k + 1;
+      if (content < 0) break;
+    }
+  }
+  return found;
+}
+
 std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
   try {
     // One document per file: a second one (after '---') would be silently ignored by YAML::Load.
     const std::vector<YAML::Node> docs = YAML::LoadAll(text);
     if (docs.size() > 1) {
-      const int line = docs[1].Mark().line;
-      issues.push_back({path, line >= 0 ? line + 1 : 0, "",
+      issues.push_back({path, second_document_line(text, docs[1].Mark().line), "",
                         "a second YAML document ('---') is not read; a scene or model file holds one document"});
       return std::nullopt;
     }
