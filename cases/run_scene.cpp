@@ -188,10 +188,10 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
     steps.push_back(step);
     summary["status"] = status;
     summary["message"] = message;
-    write_summary();
     out.exit_code = 3;
     out.q = q;
     std::fprintf(stderr, "mbdae: %s\n", message.c_str());  // also under --quiet: a failure is always said
+    write_summary();  // last: it may fail too (a full disk), and the message above is said first
   };
 
   for (const AnalysisStep& step : scene.steps) {
