@@ -1,5 +1,8 @@
 // Stage 5 of build_system(): force elements and sensors, their bodies, points and targets
 // resolved.
+#include <string>
+#include <unordered_map>
+
 #include "core/expression.h"
 #include "formulation/forces.h"
 #include "formulation/system_build.h"
@@ -8,9 +11,16 @@ namespace mbdae {
 
 namespace {
 
-void add_forces(const ModelIndex& index, System& sys) {
+// Names are looked up through hash maps, so that building stays linear in the number of names.
+using NameIndex = std::unordered_map<std::string, int>;
+
+int find_name(const NameIndex& names, const std::string& n) {
+  const auto it = names.find(n);
+  return it == names.end() ? -1 : it->second;
+}
+
+void add_forces(const ModelIndex& index, System& sys, NameIndex& force_of) {
   const Model& model = index.model;
-  // --- Forces --------------------------------------------------------------------------------
   for (const auto& fs : model.forces) {
     Force f;
     f.type = fs.type;
@@ -44,14 +54,16 @@ void add_forces(const ModelIndex& index, System& sys) {
         f.parameters.push_back(it->second);
       }
     }
-    if (sys.force_index(f.name) >= 0) fail(fs.where, "name", "force '" + f.name + "' is defined twice");
+    if (!force_of.emplace(f.name, static_cast<int>(sys.forces.size())).second)
+      fail(fs.where, "name", "force '" + f.name + "' is defined twice");
     sys.forces.push_back(f);
   }
 }
 
-void add_sensors(const ModelIndex& index, System& sys) {
+void add_sensors(const ModelIndex& index, System& sys, const NameIndex& force_of) {
   const Model& model = index.model;
-  // --- Sensors -------------------------------------------------------------------------------
+  NameIndex coordinate_of, sensor_of;
+  for (size_t k = 0; k < sys.coordinates.size(); ++k) coordinate_of.emplace(sys.coordinates[k].name, static_cast<int>(k));
   for (const auto& ss : model.sensors) {
     Sensor s;
     s.type = ss.type;
@@ -75,33 +87,28 @@ void add_sensors(const ModelIndex& index, System& sys) {
       }
       case SensorSpec::Type::kCoordinate:
       case SensorSpec::Type::kCoordinateRate:
-        s.target = sys.coordinate_index(ss.target);
+        s.target = find_name(coordinate_of, ss.target);
         if (s.target < 0) fail(ss.where, "coordinate", "no coordinate named '" + ss.target + "'");
         break;
       case SensorSpec::Type::kForceLength:
       case SensorSpec::Type::kForceValue:
-        s.target = sys.force_index(ss.target);
+        s.target = find_name(force_of, ss.target);
         if (s.target < 0) fail(ss.where, "force", "no force named '" + ss.target + "'");
         break;
       case SensorSpec::Type::kKineticEnergy:
       case SensorSpec::Type::kPotentialEnergy:
         break;  // whole-system quantities: nothing to resolve
       case SensorSpec::Type::kExpression: {
-        const int self = static_cast<int>(sys.sensors.size());
-        try {
-          s.expression = Expression::compile(ss.expression, [&](const std::string& n) {
-            for (int k = 0; k < self; ++k)
-              if (sys.sensors[k].name == n) return k;
-            return -1;
-          });
+        try {  // sensor_of holds the sensors listed before this one
+          s.expression = Expression::compile(ss.expression, [&](const std::string& n) { return find_name(sensor_of, n); });
         } catch (const ExpressionError& e) {
           fail(ss.where, "expression", std::string(e.what()) + " (names must be sensors listed before)");
         }
         break;
       }
     }
-    for (const auto& other : sys.sensors)
-      if (other.name == s.name) fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
+    if (!sensor_of.emplace(s.name, static_cast<int>(sys.sensors.size())).second)
+      fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
     sys.sensors.push_back(s);
   }
 }
@@ -109,8 +116,9 @@ void add_sensors(const ModelIndex& index, System& sys) {
 }  // namespace
 
 void add_forces_and_sensors(const ModelIndex& index, System& sys) {
-  add_forces(index, sys);
-  add_sensors(index, sys);
+  NameIndex force_of;
+  add_forces(index, sys, force_of);
+  add_sensors(index, sys, force_of);
 }
 
 }  // namespace mbdae
