@@ -1,6 +1,9 @@
 // mbdae._core: the pybind11 bindings of the public API (cases/mbdae.h), kept thin. The Python
 // package around it (cases/python/mbdae/) adds the pandas / numpy views, the exceptions with
 // their fields, and the Dask sweeps.
+#include <atomic>
+#include <chrono>
+#include <future>
 #include <memory>
 #include <string>
 #include <utility>
@@ -28,6 +31,12 @@ py::array column_view(py::object owner, const mbdae::Result& r, size_t k) {
   return std::move(a);
 }
 
+unsigned long main_thread_id() {
+  static const unsigned long id =
+      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  return id;
+}
+
 const char* step_type_name(mbdae::AnalysisStep::Type t) {
   switch (t) {
     case mbdae::AnalysisStep::Type::kAssembly: return "assembly";
@@ -39,11 +48,33 @@ const char* step_type_name(mbdae::AnalysisStep::Type t) {
 }
 
 // Runs on a private copy of the scene (another Python thread may change the caller's Scene) with
-// the GIL released, so runs in Python threads proceed in parallel.
-std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, const mbdae::RunOptions& options) {
+// the GIL released, so runs in Python threads proceed in parallel. In the main thread the run goes
+// to a helper thread while this one checks for Ctrl-C every 50 ms: a signal stops the run at its
+// next step (RunOptions::stop) and is raised (KeyboardInterrupt) once the run has ended.
+std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, mbdae::RunOptions options) {
   const mbdae::Scene copy = scene;
-  py::gil_scoped_release release;
-  return std::make_shared<mbdae::Result>(mbdae::run(copy, options));
+  const bool main_thread = PyThread_get_thread_ident() == main_thread_id();
+  if (!main_thread) {
+    py::gil_scoped_release release;
+    return std::make_shared<mbdae::Result>(mbdae::run(copy, options));
+  }
+  std::atomic<bool> stop{false};
+  options.stop = &stop;
+  auto job = std::async(std::launch::async, [&] { return std::make_shared<mbdae::Result>(mbdae::run(copy, options)); });
+  bool interrupted = false;
+  while (true) {
+    {
+      py::gil_scoped_release release;
+      if (job.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready) break;
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {
+      interrupted = true;  // the error stays set; the run ends at its next step
+      stop = true;
+    }
+  }
+  auto result = job.get();
+  if (interrupted) throw py::error_already_set();
+  return result;
 }
 
 void bind_scene(py::module_& m) {

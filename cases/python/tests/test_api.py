@@ -163,3 +163,18 @@ def test_bad_overrides_raise_scene_error_with_file_line_field():
         scene.set("forces.no_such_force.damping", 1.0)
     assert e.value.file.endswith("dynamics_step.yaml") and "no_such_force" in str(e.value)
     assert same_columns(scene.run(output_step=0.01), mbdae.load(STEP).run(output_step=0.01))  # unchanged
+
+
+def test_ctrl_c_stops_a_run_in_the_main_thread():
+    # A 20 s poster run (1.5 s CPU) interrupted after 0.5 s: KeyboardInterrupt, well before its end.
+    import subprocess
+    import sys
+    code = ("import mbdae, signal, threading, os, time\n"
+            "threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()\n"
+            "t = time.process_time()\n"
+            f"try:\n    mbdae.load({str(STEP.parent / 'dynamics_poster.yaml')!r}).run()\n"
+            "except KeyboardInterrupt:\n    print('interrupted', time.process_time() - t)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and p.stdout.startswith("interrupted"), p.stderr
+    full = mbdae.load(STEP.parent / "dynamics_poster.yaml").run(output_step=0.1).cpu_seconds()
+    assert float(p.stdout.split()[1]) < 0.8 * full
