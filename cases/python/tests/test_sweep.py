@@ -12,6 +12,7 @@ import pytest
 
 import mbdae
 from conftest import OVERRIDES, PAST_TRAVEL, STEP, needs_overrides
+from mbdae.sweep import RUN_OPTIONS, expand
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +38,7 @@ def grid_16():
 
 
 def split(run):
-    opts = {k: v for k, v in run.items() if k in mbdae.sweep.__globals__["RUN_OPTIONS"]}
+    opts = {k: v for k, v in run.items() if k in RUN_OPTIONS}
     return {k: v for k, v in run.items() if k not in opts}, opts
 
 
@@ -49,7 +50,7 @@ def test_sweep_equals_the_runs_one_by_one(client, tmp_path):
     table = mbdae.sweep(scene, grid_16(), out=tmp_path, client=client, metrics=METRICS)
     assert len(table) == 16 and list(table["status"]) == ["ok"] * 16, table[["status", "message"]]
     assert table["worker"].nunique() == 2  # both worker processes ran some
-    runs = mbdae.sweep.__globals__["expand"](grid_16())
+    runs = expand(grid_16())
     for i, run in enumerate(runs):
         overrides, opts = split(run)
         alone = scene.with_params(overrides).run(**opts)
