@@ -68,7 +68,8 @@ def throughput(n_workers, runs):
     assert (table["status"] == "ok").all()
     rate = len(table) / wall
     print(f"sweep of {len(table)} Dynamics II runs (20 s each), {n_workers} worker(s): {wall:.2f} s wall, "
-          f"{rate:.2f} runs/s; task CPU {table['cpu_s'].sum():.2f} s, integration {table['solver_cpu_s'].sum():.2f} s")
+          f"{rate:.2f} runs/s; task CPU {table['cpu_s'].sum():.2f} s, integration {table['solver_cpu_s'].sum():.2f} s, "
+          f"the workers got {100 * table['cpu_s'].sum() / (wall * n_workers):.0f} % of their cores")
     return rate
 
 

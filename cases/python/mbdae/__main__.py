@@ -24,7 +24,10 @@ def parse_values(text):
                 return s
     parts = text.split(":")
     if len(parts) == 3 and not text.startswith(("{", "[")):
-        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+        try:
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise ValueError(f"'{text}': A:B:N expects two numbers and a count") from None
         return [float(v) for v in np.linspace(a, b, n)]
     if text.startswith(("[", "{")):
         return [text]
@@ -33,7 +36,7 @@ def parse_values(text):
 
 def _pair(text, what):
     if "=" not in text:
-        raise SystemExit(f"mbdae sweep: {what} expects PATH=VALUE, got '{text}'")
+        raise ValueError(f"{what} expects PATH=VALUE, got '{text}'")
     return text.split("=", 1)
 
 
@@ -62,8 +65,15 @@ def main(argv=None):
     except mbdae.SceneError as e:
         print(e, file=sys.stderr)
         return 2
-    grid = {k: parse_values(v) for k, v in (_pair(p, "--param") for p in a.param)}
-    metrics = {k: mbdae.metrics.from_spec(v) for k, v in (_pair(m, "--metric") for m in a.metric)}
+    except ValueError as e:
+        print(f"mbdae sweep: {e}", file=sys.stderr)
+        return 1
+    try:
+        grid = {k: parse_values(v) for k, v in (_pair(p, "--param") for p in a.param)}
+        metrics = {k: mbdae.metrics.from_spec(v) for k, v in (_pair(m, "--metric") for m in a.metric)}
+    except ValueError as e:
+        print(f"mbdae sweep: {e}", file=sys.stderr)
+        return 1
     options = {k: v for k, v in (("rtol", a.rtol), ("atol", a.atol), ("output_step", a.output_step),
                                  ("formulation", a.formulation)) if v is not None}
     table = mbdae.sweep(scene, grid or [{}], a.out, client=a.scheduler, metrics=metrics, options=options,
