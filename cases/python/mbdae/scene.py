@@ -112,6 +112,8 @@ class Scene:
         if out is not None:
             opt.out_dir = str(out)
         result = Result._from_core(_scene_errors(_core.run, self._core, opt))
+        if opt.analysis >= 0 and len(result.summary.get("steps", [])) > opt.analysis + 1:
+            raise NotImplementedError("run(analysis=...): this build's mbdae::run ignores RunOptions::analysis")
         if raise_on_failure and not result.ok:
             raise SolveError(result)
         return result

@@ -33,9 +33,18 @@ needs_overrides = pytest.mark.xfail(not OVERRIDES, raises=RuntimeError, strict=T
                                     reason="mbdae::set_parameter not implemented yet in this build")
 
 
-ANALYSIS_OPTION = len(mbdae.load(PAST_TRAVEL).run(analysis=0, raise_on_failure=False).summary["steps"]) == 1
-# RunOptions::analysis (run the steps up to that one) is the API's; not honoured by run() yet.
-needs_analysis_option = pytest.mark.xfail(not ANALYSIS_OPTION, raises=AssertionError, strict=True,
+def _analysis_option_implemented():
+    try:
+        mbdae.load(PAST_TRAVEL).run(analysis=0, raise_on_failure=False)
+        return True
+    except NotImplementedError:
+        return False
+
+
+ANALYSIS_OPTION = _analysis_option_implemented()
+# RunOptions::analysis (run the steps up to that one) is the API's; Scene.run raises
+# NotImplementedError while mbdae::run ignores it.
+needs_analysis_option = pytest.mark.xfail(not ANALYSIS_OPTION, raises=NotImplementedError, strict=True,
                                           reason="RunOptions::analysis not honoured by mbdae::run yet in this build")
 
 

@@ -152,9 +152,10 @@ def test_bad_overrides_raise_scene_error_with_file_line_field():
     scene = mbdae.load(STEP)
     lines = STEP.read_text().splitlines()
     tyre_line = next(i for i, s in enumerate(lines, 1) if "name: tyre" in s)
+    stiffness_line = next(i for i, s in enumerate(lines, 1) if i >= tyre_line and "stiffness:" in s)
     with pytest.raises(mbdae.SceneError) as e:
         scene.set("forces.tyre.stiffness", -1.0)
-    assert e.value.file.endswith("dynamics_step.yaml") and e.value.line == tyre_line
+    assert e.value.file.endswith("dynamics_step.yaml") and e.value.line == stiffness_line
     assert "stiffness" in e.value.field, str(e.value)
     with pytest.raises(mbdae.SceneError) as e:
         scene.set("forces.tyre.stiffness", "[1, 2]")
