@@ -3,7 +3,7 @@
 damping and the tyre's stiffness: a grid of runs on Dask through mbdae.sweep, one figure.
 
     PYTHONPATH=build/python /usr/bin/python3 cases/five_point_suspension/wheel_hop_study.py \
-        [--out build/wheel_hop] [--workers N | --scheduler tcp://HOST:8786] [--t-end 20] [--docs]
+        [--out build/wheel_hop] [--workers N | --scheduler tcp://HOST:8786] [--t-end 20] [--rtol R] [--docs]
 
 Per run: the peak wheel-centre travel max |wheel_z - wheel_z(0)| (the run starts at rest in the
 static equilibrium), the time without tyre contact (tyre force 0, summed over the 1 ms samples),
@@ -77,12 +77,15 @@ def main():
     ap.add_argument("--t-end", type=float, help="shorter runs (the poster's first contact loss is after 13 s)")
     ap.add_argument("--damping", default="700:2800:8", help="A:B:N [N s/m]")
     ap.add_argument("--stiffness", default="1e5:4e5:5", help="A:B:N tyre stiffness [N/m]")
+    ap.add_argument("--rtol", type=float, help="override the scene's rtol (1e-7)")
+    ap.add_argument("--atol", type=float, help="override the scene's atol (1e-13)")
     ap.add_argument("--docs", action="store_true", help="also write docs/figures/wheel_hop.png")
     a = ap.parse_args()
     span = lambda s: [float(v) for v in np.linspace(*map(float, s.split(":")[:2]), int(s.split(":")[2]))]  # noqa: E731
     grid = {"forces.suspension.damping": span(a.damping), "forces.tyre.stiffness": span(a.stiffness)}
+    options = {k: v for k, v in (("rtol", a.rtol), ("atol", a.atol)) if v is not None}
     table = mbdae.sweep(poster_scene(a.t_end), grid, out=a.out, client=a.scheduler, workers=a.workers,
-                        metrics=METRICS)
+                        metrics=METRICS, options=options)
     out = Path(a.out)
     plot(table, out / "wheel_hop.png")
     if a.docs:
