@@ -36,8 +36,9 @@ def test_columns_are_views_not_copies():
 def test_options_are_the_clis(tmp_path):
     code, err = cli_run(STEP, tmp_path, "--formulation", "index1", "--output-step", "0.005", "--atol", "1e-12")
     assert code == 0, err
-    r = mbdae.load(STEP).run(formulation="index1", output_step=0.005, atol=1e-12)
-    assert csv_text(r) == (tmp_path / "results.csv").read_text()
+    r = mbdae.load(STEP).run(formulation="index1", output_step=0.005, atol=1e-12, out=tmp_path / "py")
+    assert csv_text(r) == (tmp_path / "results.csv").read_text() == (tmp_path / "py" / "results.csv").read_text()
+    assert json.loads((tmp_path / "py" / "summary.json").read_text())["status"] == "ok"
     with pytest.raises(ValueError, match="formulation"):
         mbdae.load(STEP).run(formulation="index7")
     with pytest.raises(ValueError, match="rtol"):
