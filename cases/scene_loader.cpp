@@ -18,6 +18,7 @@
 #include "cases/scene.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
+#include "core/expression.h"
 
 namespace mbdae {
 
@@ -609,6 +610,9 @@ struct Loader {
     SensorSpec s;
     s.where = where(n);
     s.name = name(n);
+    if (Expression::is_reserved(s.name))
+      error(n["name"], "name", quote(s.name) + " is reserved in expressions (reserved: " + Expression::reserved_list() +
+                                   "); choose another sensor name");
     const std::string type = text(n, "type", "", true);
     using T = SensorSpec::Type;
     static const std::map<std::string, T> types = {

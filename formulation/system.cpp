@@ -575,6 +575,8 @@ System build_system(const Model& model) {
     Sensor s;
     s.type = ss.type;
     s.name = ss.name;
+    if (Expression::is_reserved(s.name))
+      fail(ss.where, "name", "'" + s.name + "' is reserved in expressions (" + Expression::reserved_list() + ")");
     s.component = ss.component;
     switch (ss.type) {
       case SensorSpec::Type::kPosition:
