@@ -370,9 +370,13 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         auto last_print = wall0;
         bool printed = false;
         long rows = 0;
+        bool first_sample = true;
         auto output = [&](double t, const double* yy, const double* yyp) {
           max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, yyp, qo, vo, ao, step.output_projection));
-          evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
+          // Coordinate sensors unwrap against the previous sample (formulation/sensors.h).
+          evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(),
+                           first_sample ? nullptr : sensors.data());
+          first_sample = false;
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];
           if (!opt.out_dir.empty()) {

@@ -71,6 +71,78 @@ ChainParts split_chain(const JointSpec& j) {
 
 int third_axis(int a, int b) { return 3 - a - b; }
 
+
+// Bodies whose state sensor `s` reads (ground and merged coordinates read none).
+void sensor_bodies(const System& sys, const Sensor& s, std::vector<int>& out) {
+  switch (s.type) {
+    case SensorSpec::Type::kCoordinate:
+    case SensorSpec::Type::kCoordinateRate: {
+      const JointCoordinate& jc = sys.coordinates[s.target];
+      if (jc.merged) return;
+      out.push_back(jc.function.body_parent);
+      out.push_back(jc.function.body_child);
+      return;
+    }
+    case SensorSpec::Type::kForceLength:
+    case SensorSpec::Type::kForceValue:
+      out.push_back(sys.forces[s.target].bi);
+      out.push_back(sys.forces[s.target].bj);
+      return;
+    default: out.push_back(s.body); return;
+  }
+}
+
+// Compiles a load's expression components: variables t, its parameters, and sensors of the
+// kinds whose gradient is known (sensors.cpp, sensor_gradient).
+void resolve_load_expressions(const ForceSpec& fs, const System& sys, const std::vector<char>& is_expression_load,
+                              Force& f) {
+  if (fs.expression[0].empty() && fs.expression[1].empty() && fs.expression[2].empty()) return;
+  const int np = static_cast<int>(f.parameter_names.size());
+  for (const auto& pname : f.parameter_names)
+    if (Expression::is_reserved(pname))
+      fail(fs.where, "parameters." + pname, "'" + pname + "' is reserved in expressions (" + Expression::reserved_list() + ")");
+  auto lookup = [&](const std::string& n) -> int {
+    if (n == "t") return 0;
+    for (int k = 0; k < np; ++k)
+      if (f.parameter_names[k] == n) return 1 + k;
+    int s = -1;
+    for (size_t k = 0; k < sys.sensors.size(); ++k)
+      if (sys.sensors[k].name == n) s = static_cast<int>(k);
+    if (s < 0) return -1;
+    using T = SensorSpec::Type;
+    const Sensor& sensor = sys.sensors[s];
+    const T type = sensor.type;
+    if (type == T::kAcceleration || type == T::kExpression || type == T::kKineticEnergy ||
+        type == T::kPotentialEnergy)
+      throw ExpressionError("sensor '" + n + "' cannot drive a load (loads read position, velocity, axis, "
+                            "coordinate, coordinate_rate, force_length and force_value sensors)", 0);
+    if ((type == T::kForceLength || type == T::kForceValue) &&
+        is_expression_load[sensor.target])
+      throw ExpressionError("sensor '" + n + "' measures a load given by an expression (loads may not depend on each other)", 0);
+    auto it = std::find(f.inputs.begin(), f.inputs.end(), s);
+    if (it == f.inputs.end()) f.inputs.push_back(s);
+    return 1 + np + static_cast<int>(std::find(f.inputs.begin(), f.inputs.end(), s) - f.inputs.begin());
+  };
+  for (int c = 0; c < 3; ++c) {
+    if (fs.expression[c].empty()) continue;
+    const char* field = fs.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+    try {
+      f.expression[c] = Expression::compile(fs.expression[c], lookup);
+    } catch (const ExpressionError& e) {
+      fail(fs.where, field, std::string(e.what()) + " (names are t, the force's parameters and sensors)");
+    }
+  }
+  for (int s : f.inputs) sensor_bodies(sys, sys.sensors[s], f.reads);
+  f.reads.erase(std::remove(f.reads.begin(), f.reads.end(), -1), f.reads.end());
+  std::sort(f.reads.begin(), f.reads.end());
+  f.reads.erase(std::unique(f.reads.begin(), f.reads.end()), f.reads.end());
+  if (static_cast<int>(f.reads.size()) > kMaxLoadReads)
+    fail(fs.where, "type", "the load's expressions read " + std::to_string(f.reads.size()) + " bodies (at most " +
+                               std::to_string(kMaxLoadReads) + ")");
+  if (1 + np + static_cast<int>(f.inputs.size()) > kMaxLoadVariables)
+    fail(fs.where, "parameters", "the load's expressions use more than " + std::to_string(kMaxLoadVariables) +
+                                     " parameters and sensors");
+}
 }  // namespace
 
 int System::num_constraint_rows() const {
@@ -194,8 +266,7 @@ System build_system(const Model& model) {
   };
   auto anchor_of = [&](const JointSpec& j) -> Vec3 {
     if (j.anchor_point.empty()) return j.anchor;
-    if (j.parent == kGround) fail(j.where, "anchor", "ground has no named points");
-    const auto& pts = body_by_name[j.parent]->points;
+    const auto& pts = j.parent == kGround ? model.ground_points : body_by_name[j.parent]->points;
     auto it = pts.find(j.anchor_point);
     if (it == pts.end())
       fail(j.where, "anchor", "body '" + j.parent + "' has no point '" + j.anchor_point + "'");
@@ -442,7 +513,11 @@ System build_system(const Model& model) {
     auto it = sys.frames.find(body);
     if (it == sys.frames.end()) fail(w, field, "no body named '" + body + "'");
     if (point.empty() || point == "origin") return {&it->second, it->second.local_point(Vec3::Zero())};
-    if (body == kGround) fail(w, field, "ground has no named points");
+    if (body == kGround) {
+      auto gp = model.ground_points.find(point);
+      if (gp == model.ground_points.end()) fail(w, field, "ground has no point '" + point + "'");
+      return {&it->second, gp->second};
+    }
     const BodySpec* b = body_by_name[body];
     if (point == "com") return {&it->second, it->second.local_point(b->com)};
     auto pt = b->points.find(point);
@@ -537,14 +612,26 @@ System build_system(const Model& model) {
     Force f;
     f.type = fs.type;
     f.name = fs.name;
-    auto [b1, p1] = point_of(fs.body1, fs.point1, fs.where, "body1");
+    // A point given as [x, y, z] in the body frame, or by name.
+    auto located = [&](const std::string& body, const std::string& name, bool at_xyz, const Vec3& xyz,
+                       const SourceLocation& w, const std::string& field) {
+      auto p = point_of(body, at_xyz ? "" : name, w, field);
+      if (at_xyz) p.second = p.first->local_point(xyz);
+      return p;
+    };
+    const bool on_coordinate = fs.type == ForceSpec::Type::kJointSpringDamper;  // no body point
+    auto [b1, p1] = located(on_coordinate ? kGround : fs.body1, fs.point1, fs.at_xyz1, fs.xyz1, fs.where, "body1");
     f.bi = b1->body;
     f.si = p1;
-    if (fs.type == ForceSpec::Type::kSpringDamper || fs.type == ForceSpec::Type::kUser) {
-      auto [b2, p2] = point_of(fs.body2, fs.point2, fs.where, "body2");
+    if (fs.type == ForceSpec::Type::kSpringDamper || fs.type == ForceSpec::Type::kUser ||
+        fs.type == ForceSpec::Type::kBushing) {
+      auto [b2, p2] = located(fs.body2, fs.point2, fs.at_xyz2, fs.xyz2, fs.where, "body2");
       f.bj = b2->body;
       f.sj = p2;
+      f.frame_j = b2->rotation;
     }
+    f.frame_i = b1->rotation;
+    f.body_frame = fs.body_frame;
     f.stiffness = fs.stiffness;
     f.damping = fs.damping;
     f.free_length = fs.free_length;
@@ -556,6 +643,27 @@ System build_system(const Model& model) {
     f.axis = b1->local_vector(fs.axis.normalized());
     if (fs.type == ForceSpec::Type::kWheelContact && f.bi < 0)
       fail(fs.where, "body1", "wheel contact on a body merged into ground");
+    if (fs.type == ForceSpec::Type::kTorque && !fs.body_frame) f.axis = fs.axis.normalized();
+    f.kt = fs.translational_stiffness;
+    f.ct = fs.translational_damping;
+    f.kr = fs.rotational_stiffness;
+    f.cr = fs.rotational_damping;
+    if (fs.type == ForceSpec::Type::kBushing && f.bi == f.bj)
+      fail(fs.where, "body2", "bushing '" + fs.name + "' joins two parts of the same rigid body");
+    if (fs.type == ForceSpec::Type::kJointSpringDamper) {
+      const int k = sys.coordinate_index(fs.coordinate);
+      if (k < 0) fail(fs.where, "coordinate", "no joint coordinate named '" + fs.coordinate + "'");
+      if (sys.coordinates[k].merged)
+        fail(fs.where, "coordinate", "coordinate '" + fs.coordinate + "' belongs to a locked joint");
+      f.coordinate = sys.coordinates[k].function;
+      f.bi = f.coordinate.body_parent;
+      f.bj = f.coordinate.body_child;
+    }
+    for (const auto& [pname, value] : fs.parameters)
+      if (fs.type != ForceSpec::Type::kUser) {
+        f.parameter_names.push_back(pname);
+        f.parameters.push_back(value);
+      }
     if (fs.type == ForceSpec::Type::kUser) {
       f.law = find_force_law(fs.law);
       if (!f.law) fail(fs.where, "law", "no force law named '" + fs.law + "' is registered");
@@ -582,9 +690,9 @@ System build_system(const Model& model) {
       case SensorSpec::Type::kPosition:
       case SensorSpec::Type::kVelocity:
       case SensorSpec::Type::kAcceleration: {
-        auto [b, p] = point_of(ss.body, ss.point, ss.where, "body");
+        auto [b, p] = point_of(ss.body, ss.at_xyz ? "" : ss.point, ss.where, "body");
         s.body = b->body;
-        s.point = p;
+        s.point = ss.at_xyz ? b->local_point(ss.xyz) : p;
         break;
       }
       case SensorSpec::Type::kAxis: {
@@ -598,6 +706,8 @@ System build_system(const Model& model) {
       case SensorSpec::Type::kCoordinateRate:
         s.target = sys.coordinate_index(ss.target);
         if (s.target < 0) fail(ss.where, "coordinate", "no coordinate named '" + ss.target + "'");
+        s.unwrap = ss.type == SensorSpec::Type::kCoordinate && !ss.wrap && sys.coordinates[s.target].function.rotation;
+        s.reference = sys.coordinates[s.target].spec.initial;
         break;
       case SensorSpec::Type::kForceLength:
       case SensorSpec::Type::kForceValue:
@@ -625,6 +735,13 @@ System build_system(const Model& model) {
       if (other.name == s.name) fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
     sys.sensors.push_back(s);
   }
+
+  // --- Load expressions (after the sensors they read) --------------------------------------
+  std::vector<char> is_expression_load;
+  for (const auto& fs : model.forces)
+    is_expression_load.push_back(!fs.expression[0].empty() || !fs.expression[1].empty() || !fs.expression[2].empty());
+  for (size_t k = 0; k < model.forces.size(); ++k)
+    resolve_load_expressions(model.forces[k], sys, is_expression_load, sys.forces[k]);
   return sys;
 }
 
