@@ -97,8 +97,14 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     case T::kAxis: return "1";
     case T::kCoordinate: return sys.coordinates[s.target].function.rotation ? "rad" : "m";
     case T::kCoordinateRate: return sys.coordinates[s.target].function.rotation ? "rad/s" : "m/s";
-    case T::kForceLength: return "m";
-    case T::kForceValue: return "N";
+    case T::kForceLength:
+    case T::kForceValue: {  // torques and rotational joint springs measure angles and moments
+      const Force& f = sys.forces[s.target];
+      const bool rotational = f.type == ForceSpec::Type::kTorque ||
+                              (f.type == ForceSpec::Type::kJointSpringDamper && f.coordinate.rotation);
+      if (s.type == T::kForceLength) return rotational ? (f.type == ForceSpec::Type::kTorque ? "1" : "rad") : "m";
+      return rotational ? "N m" : "N";
+    }
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
     case T::kExpression: return "";

@@ -180,8 +180,7 @@ void point_force_eval(const Force& f, const LocalState& x, double t, const LoadI
 void joint_spring_eval(const Force& f, const LocalState& x, const LocalState& v, Vec14& q,
                        Mat14* dqx, Mat14* dqv) {
   const ScalarJet jet = coordinate_jet(f.coordinate, x);
-  Vec14 vl;
-  vl << v.ri, v.pi, v.rj, v.pj;
+  const Vec14 vl = local_vector(v);
   const double stretch =
       f.coordinate.rotation ? wrap_angle(jet.value - f.free_length) : jet.value - f.free_length;
   const double rate = jet.grad.dot(vl);
@@ -248,21 +247,14 @@ Vec14 bushing_force(const Force& f, const LocalState& x, const Vec14& vl) {
 }
 
 LocalState shifted(const LocalState& x, int l, double h) {
-  Vec14 y;
-  y << x.ri, x.pi, x.rj, x.pj;
+  Vec14 y = local_vector(x);
   y[l] += h;
-  LocalState s;
-  s.ri = y.segment<3>(0);
-  s.pi = y.segment<4>(3);
-  s.rj = y.segment<3>(7);
-  s.pj = y.segment<4>(10);
-  return s;
+  return local_state(y);
 }
 
 void bushing_eval(const Force& f, const LocalState& x, const LocalState& v, Vec14& q, Mat14* dqx,
                   Mat14* dqv) {
-  Vec14 vl;
-  vl << v.ri, v.pi, v.rj, v.pj;
+  const Vec14 vl = local_vector(v);
   q += bushing_force(f, x, vl);
   if (!dqx) return;
   Eigen::Matrix<double, 6, 1> y, c;
@@ -270,8 +262,7 @@ void bushing_eval(const Force& f, const LocalState& x, const LocalState& v, Vec1
   bushing_coordinates(f, x, y, jac);
   c << f.ct, f.cr;
   *dqv -= jac.transpose() * c.asDiagonal() * jac;
-  Vec14 xl;
-  xl << x.ri, x.pi, x.rj, x.pj;
+  const Vec14 xl = local_vector(x);
   for (int l = 0; l < 14; ++l) {
     if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
     const double h = 1e-6 * std::max(1.0, std::fabs(xl[l]));
@@ -279,6 +270,21 @@ void bushing_eval(const Force& f, const LocalState& x, const LocalState& v, Vec1
   }
 }
 }  // namespace
+
+Vec14 local_vector(const LocalState& s) {
+  Vec14 y;
+  y << s.ri, s.pi, s.rj, s.pj;
+  return y;
+}
+
+LocalState local_state(const Vec14& y) {
+  LocalState s;
+  s.ri = y.segment<3>(0);
+  s.pi = y.segment<4>(3);
+  s.rj = y.segment<3>(7);
+  s.pj = y.segment<4>(10);
+  return s;
+}
 
 void register_force_law(const UserForceLaw& law) {
   static std::mutex m;
@@ -400,8 +406,7 @@ double force_magnitude(const Force& f, const LocalState& x, const LocalState& v,
       Eigen::Matrix<double, 6, 1> y;
       Eigen::Matrix<double, 6, 14> jac;
       bushing_coordinates(f, x, y, jac);
-      Vec14 vl;
-      vl << v.ri, v.pi, v.rj, v.pj;
+      const Vec14 vl = local_vector(v);
       return (f.kt.cwiseProduct(y.head<3>()) + f.ct.cwiseProduct((jac * vl).head<3>())).norm();
     }
     default: {

@@ -55,6 +55,10 @@ struct UserForceLaw {
 void register_force_law(const UserForceLaw& law);
 const UserForceLaw* find_force_law(const std::string& name);
 
+// A local state as the 14-vector (r_i, p_i, r_j, p_j), and back.
+Vec14 local_vector(const LocalState& s);
+LocalState local_state(const Vec14& y);
+
 // Values of a load's expression components (index 0..2) and their derivatives with respect to
 // the positions and velocities of the bodies in Force::reads (7 columns per body, in order).
 struct LoadInput {

@@ -66,20 +66,6 @@ struct SensorGradient {
   Row14 dq = Row14::Zero(), dv = Row14::Zero();
 };
 
-Vec14 local_vector(const LocalState& s) {
-  Vec14 y;
-  y << s.ri, s.pi, s.rj, s.pj;
-  return y;
-}
-LocalState local_state(const Vec14& y) {
-  LocalState s;
-  s.ri = y.segment<3>(0);
-  s.pi = y.segment<4>(3);
-  s.rj = y.segment<3>(7);
-  s.pj = y.segment<4>(10);
-  return s;
-}
-
 SensorGradient force_sensor_gradient(const System& sys, const Sensor& s,
                                      const std::vector<char>& modes, const double* q,
                                      const double* v, double t) {
