@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 
+#include "cases/error_estimate.h"
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "core/errors.h"
@@ -15,7 +16,7 @@
 namespace {
 void usage() {
   std::fprintf(stderr,
-               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
+               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
                "                  [--output-step DT]\n"
                "                  [--formulation index3|index2-ggl|index1|penalty]\n"
                "       mbdae check SCENE.yaml\n");
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   const bool check_only = std::strcmp(argv[1], "check") == 0;
   const std::string scene_path = argv[2];
   mbdae::RunOptions opt;
+  bool error_estimate = false;
   opt.verbose = true;
   opt.progress = true;
   opt.keep_rows = false;
@@ -58,12 +60,14 @@ int main(int argc, char** argv) {
       opt.output_step = v;
     } else if (a == "--formulation" && i + 1 < argc) {
       opt.formulation = argv[++i];
-      if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1" &&
+      if (opt.formulation != "index3" && opt.formulation != "index3-positions" && opt.formulation != "index2-ggl" && opt.formulation != "index1" &&
           opt.formulation != "penalty") {
         std::fprintf(stderr, "mbdae: --formulation expects index3, index2-ggl, index1 or penalty, got '%s'\n",
                      opt.formulation.c_str());
         return 1;
       }
+    } else if (a == "--error-estimate") {
+      error_estimate = true;  // cases/error_estimate.h
     } else if (a == "--quiet") {
       opt.verbose = false;
       opt.progress = false;
@@ -85,6 +89,7 @@ int main(int argc, char** argv) {
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
+    if (error_estimate || mbdae::error_estimate_requested(scene)) return mbdae::run_with_error_estimate(scene, opt);
     const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
     return r.exit_code;
   } catch (const mbdae::SceneError& e) {

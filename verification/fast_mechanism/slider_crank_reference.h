@@ -19,7 +19,7 @@ struct SliderCrankParameters {
   double m_crank = 0.005, j_crank = 2e-7;  // mass [kg], inertia about its centre of mass [kg m^2]
   double m_rod = 0.004, j_rod = 4e-7;
   double m_piston = 0.006;
-  double torque = 0.01;                // [N m]
+  double torque = 0.04;                // [N m]
   double theta0 = 0.3;                 // crank angle at rest at t = 0 [rad]
 };
 
