@@ -112,7 +112,10 @@ void MultibodyDae::position_weights(const double* y, double rtol, double aq, dou
 
 void MultibodyDae::state_weights(double h, const double* y, double rtol, double atol, double* w) const {
   const double aq = position_atol(y, abs_tol_.set() ? abs_tol_.position : atol);
-  const double ap = abs_tol_.set() ? std::fmax(abs_tol_.rotation, 10 * 2.22e-16) : aq;
+  // Euler parameters floored like every coordinate before model-unit tolerances: at ten
+  // roundings of the largest coordinate (a 40-bar four-bar whose couplers' e1..e3 stay 0 fails
+  // with a floor of ten roundings of 1).
+  const double ap = abs_tol_.set() ? position_atol(y, abs_tol_.rotation) : aq;
   const double av = velocity_atol(h, y, abs_tol_.set() ? abs_tol_.velocity : atol);
   const double ar = abs_tol_.set() ? velocity_atol(h, y, abs_tol_.rotation_rate) : av;
   for (int i = 0; i < nq_; ++i) {
