@@ -4,12 +4,10 @@
 #include <cmath>
 
 #include "verification/fast_mechanism/slider_crank_reference.h"
-#include "verification/fast_mechanism/torque_couple.h"
 
 namespace mbdae {
 
 Scene load_fast_mechanism() {
-  register_torque_couple_law();
   return load_scene(std::string(MBDAE_SOURCE_DIR) + "/verification/fast_mechanism/slider_crank_fast.yaml");
 }
 

@@ -17,7 +17,7 @@ struct FastMechanismErrors {
   double final_rate = 0;              // reference crank rate at the end [rad/s]
 };
 
-// The scene, with the torque law registered (call before loading it).
+// The scene verification/fast_mechanism/slider_crank_fast.yaml.
 Scene load_fast_mechanism();
 // Compares r (a run of the scene) with the reference at the same sample times.
 FastMechanismErrors fast_mechanism_errors(const Result& r, double reference_tol = 1e-13);
