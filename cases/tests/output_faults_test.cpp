@@ -22,6 +22,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cases/tests/run_command.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -44,23 +46,8 @@ analysis:
   - {type: dynamics, t_end: T_END, output_step: 0.001}
 )";
 
-struct CliResult {
-  int code = -1;
-  std::string output;
-};
-
-// Runs a shell command line (stderr into the output); the exit code of the shell.
-CliResult shell(const std::string& cmd) {
-  CliResult r;
-  FILE* p = popen(("(" + cmd + ") 2>&1").c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using CliResult = mbdae::test_support::CommandResult;
+CliResult shell(const std::string& cmd) { return mbdae::test_support::run_command(cmd); }
 
 std::string sh_quote(const fs::path& p) { return "'" + p.string() + "'"; }
 std::string exe() { return std::string("'") + MBDAE_EXE + "'"; }
