@@ -20,20 +20,18 @@ namespace {
 constexpr size_t kBufferBytes = 1 << 16;  // whole rows collected per write(2)
 
 // Test hook: MBDAE_OUTPUT_FAULT_BYTES=N makes every output file hold at most N bytes, as if the
-// file system were full (a write that crosses N writes up to N, then fails with ENOSPC).
+// file system were full (a write that crosses N writes up to N, then fails with ENOSPC). Read at
+// every write (one per 64 kB of rows), so that a test can set and clear it.
 long long fault_limit() {
-  static const long long limit = [] {
-    const char* s = std::getenv("MBDAE_OUTPUT_FAULT_BYTES");
-    return s && *s ? std::atoll(s) : -1LL;
-  }();
-  return limit;
+  const char* s = std::getenv("MBDAE_OUTPUT_FAULT_BYTES");
+  return s && *s ? std::atoll(s) : -1LL;
 }
 
 // Writes n bytes at the end of a file that holds `written` bytes; 0 or the errno of the failure.
 int write_all(int fd, const char* data, size_t n, long long written) {
+  const long long limit = fault_limit();
   while (n > 0) {
     size_t chunk = n;
-    const long long limit = fault_limit();
     if (limit >= 0) {
       if (written >= limit) return ENOSPC;
       chunk = static_cast<size_t>(std::min<long long>(static_cast<long long>(n), limit - written));
