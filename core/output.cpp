@@ -204,11 +204,12 @@ OutputFolderLock::OutputFolderLock(const std::string& dir) {
   if (fd_ < 0) throw OutputError("cannot lock output folder '" + dir + "' (" + path + ": " + os_error(errno) + ")");
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
+    if (err == ENOLCK || err == EOPNOTSUPP || err == ENOTSUP) return;  // a file system without locks: run unlocked
     char pid[32] = {0};
     const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
     ::close(fd_);
     fd_ = -1;
-    if (err == EWOULDBLOCK)
+    if (err == EWOULDBLOCK || err == EAGAIN)
       throw OutputError("output folder '" + dir + "' is in use by another run" +
                         (n > 0 ? " (process " + std::string(pid, static_cast<size_t>(n)) + ")" : std::string()) +
                         "; wait for it or choose another --out");
