@@ -18,6 +18,8 @@
 
 #include "cases/field_ranges.h"
 #include "cases/scene.h"
+#include "cases/scene_overrides.h"
+#include "cases/scene_source.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
 
@@ -900,10 +902,13 @@ std::optional<YAML::Node> parse(const std::string& text, const std::string& path
   }
 }
 
-// Loads into `scene`; returns false if the scene could not be read far enough to be validated.
-bool load(const std::string& text, const std::string& path, Scene& scene, std::vector<SceneIssue>& issues,
-          FieldLines& lines) {
-  const auto parsed = parse(text, path, issues);
+// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
+// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
+// the scene could not be read far enough to be validated.
+bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
+          std::vector<OverrideTarget>& targets) {
+  const std::string& path = src.path;
+  const auto parsed = parse(src.text, path, issues);
   if (!parsed) return false;
   const YAML::Node root = *parsed;
   Loader scene_loader{path, &issues, &lines};
@@ -913,32 +918,37 @@ bool load(const std::string& text, const std::string& path, Scene& scene, std::v
     return false;
   }
   lines.scene_root = scene_loader.where(root);
-  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                          "forces", "sensors", "remove", "analysis", "output",
-                                          "redundant_constraints"});
   bool complete = true;
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
   if (scene_loader.has(root, "model")) {
     const std::string model = scene_loader.name(root, "model");
     if (model.empty()) {
       complete = false;
     } else {
-      const std::string model_path = (std::filesystem::path(path).parent_path() / model).string();
+      model_path = (std::filesystem::path(path).parent_path() / model).string();
       std::string why;
-      const auto model_text = read_text_file(model_path, why);
-      std::optional<YAML::Node> mroot;
+      auto known = src.models.find(model_path);
+      const auto model_text = known != src.models.end() ? std::optional<std::string>(known->second)
+                                                        : read_text_file(model_path, why);
       if (!model_text) scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
-      else mroot = parse(*model_text, model_path, issues);
-      if (!mroot) {
-        complete = false;
-      } else {
-        Loader model_loader{model_path, &issues, &lines};
-        if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                                      "forces", "sensors"}))
-          model_loader.sections(*mroot, scene.model, false);
-        else
-          complete = false;
-      }
+      else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
+      if (!mroot) complete = false;
     }
+  }
+  if (!complete && !src.overrides.empty()) return false;
+  for (const auto& [p, v] : src.overrides)
+    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
+  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
+                                          "forces", "sensors", "remove", "analysis", "output",
+                                          "redundant_constraints"});
+  if (mroot) {
+    Loader model_loader{model_path, &issues, &lines};
+    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
+                                                  "forces", "sensors"}))
+      model_loader.sections(*mroot, scene.model, false);
+    else
+      complete = false;
   }
   scene_loader.sections(root, scene.model, true);
   for (const std::string& name : scene_loader.names(root, "remove")) {
@@ -1004,20 +1014,41 @@ std::vector<std::string> messages(const std::vector<SceneIssue>& issues) {
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& path) {
+// Loads a scene from its source; issues at an override's place say which parameter set it.
+Scene load_source(SceneSource src) {
   Scene scene;
-  scene.file = path;
+  scene.file = src.path;
   std::vector<SceneIssue> issues;
+  std::vector<OverrideTarget> targets;
   FieldLines lines;
   bool complete = false;
   try {
-    complete = load(text, path, scene, issues, lines);
+    complete = load(src, scene, issues, lines, targets);
   } catch (const YAML::Exception& e) {  // a node shape the loader did not expect
-    issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "cannot read the scene: " + e.msg});
+    issues.push_back({src.path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "cannot read the scene: " + e.msg});
   }
   if (complete) validate_scene(scene, lines, issues);
+  for (auto& i : issues)
+    for (const auto& t : targets)
+      if (i.file == t.file && i.line == t.line) i.message += " (set by parameter " + t.path + " = " + quote(t.value) + ")";
   if (!issues.empty()) throw SceneError(messages(issues));
+  scene.source = std::make_shared<const SceneSource>(std::move(src));
   return scene;
+}
+
+Scene load_scene_text(const std::string& text, const std::string& path) {
+  SceneSource src;
+  src.path = path;
+  src.text = text;
+  return load_source(std::move(src));
+}
+
+Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides) {
+  if (!scene.source)
+    throw SceneError({ModelError::format(scene.file, 0, "", "this scene was not loaded from YAML; it has no parameters to set")});
+  SceneSource src = *scene.source;
+  src.overrides.insert(src.overrides.end(), overrides.begin(), overrides.end());
+  return load_source(std::move(src));
 }
 
 Scene load_scene(const std::string& path) {
