@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   mbdae::RunOptions& opt = cl.options;
-  opt.stop = mbdae::install_stop_signals();
+  if (!cl.check_only) opt.stop = mbdae::install_stop_signals();  // check: Ctrl-C ends it at once
   try {
     const mbdae::Scene scene = mbdae::load_scene(cl.scene_path);
     if (cl.check_only) {
