@@ -212,8 +212,8 @@ double force_switch_value(const Force& f, const LocalState& x, double t) {
   return f.type == ForceSpec::Type::kWheelContact ? contact(f, x, t, false).e : 0.0;
 }
 
-double force_length(const Force& f, const LocalState& x) {
-  if (f.type == ForceSpec::Type::kWheelContact) return contact(f, x, 0.0, false).e;
+double force_length(const Force& f, const LocalState& x, double t) {
+  if (f.type == ForceSpec::Type::kWheelContact) return contact(f, x, t, false).e;
   return (point(f.bj, x.rj, x.pj, f.sj) - point(f.bi, x.ri, x.pi, f.si)).norm();
 }
 

@@ -46,7 +46,7 @@ double potential_energy(const System& sys, const std::vector<char>& modes, const
     const Force& f = sys.forces[k];
     switch (f.type) {
       case ForceSpec::Type::kSpringDamper: {
-        const double stretch = force_length(f, gather(q, f.bi, f.bj)) - f.free_length;
+        const double stretch = force_length(f, gather(q, f.bi, f.bj), t) - f.free_length;
         u += 0.5 * f.stiffness * stretch * stretch;
         break;
       }
@@ -101,7 +101,7 @@ void evaluate_sensors(const System& sys, const std::vector<char>& modes, const d
       case SensorSpec::Type::kCoordinateRate: value = coordinate_rate(sys, s.target, q, v); break;
       case SensorSpec::Type::kForceLength: {
         const Force& f = sys.forces[s.target];
-        value = force_length(f, gather(q, f.bi, f.bj));
+        value = force_length(f, gather(q, f.bi, f.bj), t);
         break;
       }
       case SensorSpec::Type::kForceValue: {
