@@ -1,5 +1,7 @@
 #include "formulation/mechanics.h"
 
+#include "formulation/sensors.h"
+
 #include <cmath>
 #include <cstdlib>
 
@@ -67,7 +69,9 @@ void generalized_forces(const System& sys, const std::vector<char>& modes, const
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
-    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr);
+    LoadInput in;
+    if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr, &in);
     for (int l = 0; l < 14; ++l) {
       const int g = global_index(f.bi, f.bj, l);
       if (g >= 0) out[g] += ql[l];
@@ -180,7 +184,29 @@ void assemble_force_derivatives(const System& sys, const std::vector<char>& mode
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
     Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
-    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+    if (!f.has_expression()) {
+      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+    } else {
+      // Chain rule through the expression components to the bodies they read (forces.h).
+      const LoadInput in = load_input(sys, f, modes, q, v, t, true);
+      Mat14x3 dqin = Mat14x3::Zero();
+      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in, &dqin);
+      for (size_t r = 0; r < f.reads.size(); ++r)
+        for (int m = 0; m < 7; ++m) {
+          const int col = 7 * f.reads[r] + m, slot = 7 * static_cast<int>(r) + m;
+          for (int l = 0; l < 14; ++l) {
+            const int g = global_index(f.bi, f.bj, l);
+            if (g < 0) continue;
+            double wq = 0, wv = 0;
+            for (int c = 0; c < 3; ++c) {
+              wq += dqin(l, c) * in.dq[c][slot];
+              wv += dqin(l, c) * in.dv[c][slot];
+            }
+            a.add(row0 + g, colq + col, -wq);
+            if (colv >= 0) a.add(row0 + g, colv + col, -wv);
+          }
+        }
+    }
     add_local_block(f.bi, f.bj, -dx, row0, colq, true, a);
     if (colv >= 0) add_local_block(f.bi, f.bj, -dv, row0, colv, true, a);
   }
