@@ -487,7 +487,8 @@ struct Loader {
   }
 
   void cut(const YAML::Node& n, Model& m) {
-    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "distance"};
+    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "ref1", "ref2",
+                                   "distance"};
     if (!check_keys(n, "cut", general)) return;
     CutSpec c;
     c.where = where(n);
@@ -506,9 +507,10 @@ struct Loader {
     else if (type == "weld") c.type = CutSpec::Type::kWeld;
     else if (type == "distance") c.type = CutSpec::Type::kDistance;
     else if (!type.empty()) error(n["type"], "type", "unknown cut type " + quote(type) + " (ball, revolute, universal, prismatic, weld, distance)");
-    if (type == "ball" || type == "weld") applies(n, "a " + type + " cut", general, base);
+    if (type == "ball") applies(n, "a ball cut", general, base);
     if (type == "revolute" || type == "universal") applies(n, "a " + type + " cut", general, with({"axis1", "axis2"}));
-    if (type == "prismatic") applies(n, "a prismatic cut", general, with({"axis1"}));
+    if (type == "weld" || type == "prismatic")
+      applies(n, "a " + type + " cut", general, with({"axis1", "axis2", "ref1", "ref2"}));
     if (type == "distance") applies(n, "a distance cut", general, with({"distance"}));
     c.body1 = name(n, "body1");
     c.body2 = name(n, "body2");
@@ -518,6 +520,10 @@ struct Loader {
     c.axis2 = vec3(n, "axis2", c.axis1);
     if (c.axis1.norm() == 0) error(at(n, "axis1"), "axis1", "must not be zero");
     if (has(n, "axis2") && c.axis2.norm() == 0) error(at(n, "axis2"), "axis2", "must not be zero");
+    c.ref1 = vec3(n, "ref1", Vec3::Zero());
+    c.ref2 = vec3(n, "ref2", c.ref1);
+    if (has(n, "ref1") && c.ref1.norm() == 0) error(at(n, "ref1"), "ref1", "must not be zero");
+    if (has(n, "ref2") && c.ref2.norm() == 0) error(at(n, "ref2"), "ref2", "must not be zero");
     if (c.type == CutSpec::Type::kDistance) {
       const auto d = opt_number(n, "distance", true);
       c.distance = d.value_or(0.0);
