@@ -31,7 +31,6 @@ class KluSolver {
   double condest();
   int factorizations() const { return factorizations_; }
   int full_factorizations() const { return full_factorizations_; }
-  int status() const { return common_.status; }
 
  private:
   void free_numeric();
