@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
 
+#include "cases/animation_sink.h"
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "core/errors.h"
@@ -16,7 +18,7 @@ namespace {
 void usage() {
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
-               "                  [--output-step DT]\n"
+               "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation index3|index2-ggl|index1|penalty]\n"
                "       mbdae check SCENE.yaml\n");
 }
@@ -38,6 +40,8 @@ int main(int argc, char** argv) {
   opt.verbose = true;
   opt.progress = true;
   opt.keep_rows = false;
+  bool animation = false;  // DIR/animation.pvd (cases/animation_sink.h)
+  double animation_rate = 0;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc) {
@@ -64,6 +68,14 @@ int main(int argc, char** argv) {
                      opt.formulation.c_str());
         return 1;
       }
+    } else if (a == "--animation") {
+      animation = true;
+    } else if (a == "--animation-rate" && i + 1 < argc) {
+      if (!parse_number(argv[++i], animation_rate) || !(animation_rate > 0)) {
+        std::fprintf(stderr, "mbdae: --animation-rate expects a positive number of frames per second, got '%s'\n", argv[i]);
+        return 1;
+      }
+      animation = true;
     } else if (a == "--quiet") {
       opt.verbose = false;
       opt.progress = false;
@@ -85,8 +97,11 @@ int main(int argc, char** argv) {
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
-    const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
-    return r.exit_code;
+    std::unique_ptr<mbdae::AnimationSink> anim;
+    if (animation || scene.animation.write) anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, animation_rate);
+    std::vector<mbdae::Sink*> sinks;
+    if (anim) sinks.push_back(anim.get());
+    return mbdae::run(scene, opt, sinks).exit_code;
   } catch (const mbdae::SceneError& e) {
     for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());
     return 2;

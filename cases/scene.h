@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "cases/animation_spec.h"
 #include "formulation/model.h"
 
 namespace mbdae {
@@ -40,6 +41,7 @@ struct Scene {
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
   std::string redundant_constraints = "remove";  // or "fail"
+  AnimationSpec animation;  // cases/animation_spec.h
 };
 
 // One message per problem found in the scene (file:line: field 'x': ...).
