@@ -358,12 +358,15 @@ void AnimationSink::write_static_frame(const Result& result) {
   static_system_ = std::make_unique<System>(build_system(scene_.model));
   System& sys = *static_system_;
   if (result.q.size() != static_cast<size_t>(sys.nq())) return;
-  for (const auto& step : result.summary.value("steps", nlohmann::ordered_json::array()))
-    for (const auto& [key, value] : step.value("parameters", nlohmann::ordered_json::object()).items()) {
+  const nlohmann::ordered_json steps = result.summary.value("steps", nlohmann::ordered_json::array());
+  for (const auto& step : steps) {
+    const nlohmann::ordered_json parameters = step.value("parameters", nlohmann::ordered_json::object());
+    for (const auto& [key, value] : parameters.items()) {
       const size_t dot = key.rfind('.');
       const int f = sys.force_index(key.substr(0, dot));
       if (double* p = f >= 0 ? force_parameter(sys.forces[f], key.substr(dot + 1)) : nullptr) *p = value;
     }
+  }
   const double t = scene_.steps.empty() ? 0.0 : scene_.steps.back().t0;
   start(sys, t, t);
   const std::vector<double> v(sys.nq(), 0.0);
