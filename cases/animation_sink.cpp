@@ -238,6 +238,11 @@ void draw_forces(const System& sys, const double* q, const double* v, const std:
       const Vec3 vec = f.type == ForceSpec::Type::kPointForce ? Vec3(f.fx.value(t), f.fy.value(t), f.fz.value(t))
                                                               : Vec3(0, 0, value);
       pt.cell(pt.data.verts, {pt.add_point(xi, vec)}, AnimationPart::kForceVector, -1, index, -1, value);
+      if (f.type == ForceSpec::Type::kWheelContact) {
+        const Vec3 below(xi.x(), xi.y(), f.ground.value(t));
+        const int a = pt.add_point(below - f.radius * Vec3::UnitX()), b = pt.add_point(below + f.radius * Vec3::UnitX());
+        pt.cell(pt.data.lines, {a, b}, AnimationPart::kGround, -1, index);
+      }
     } else {
       const int i = pt.add_point(xi), j = pt.add_point(world({f.bj, f.sj}, q));
       pt.cell(pt.data.lines, {i, j}, AnimationPart::kForceLine, -1, index, -1, value);
@@ -260,7 +265,7 @@ void draw_shapes(const AnimationPlan& plan, const double* q, Painter& pt) {
 nlohmann::ordered_json legend(const AnimationPlan& plan, const System& sys) {
   nlohmann::ordered_json j;
   j["parts"] = {{"0", "axis"}, {"1", "body_line"}, {"2", "body_point"}, {"3", "joint"},
-                {"4", "cut"}, {"5", "force_line"}, {"6", "force_vector"}, {"7", "shape"}};
+                {"4", "cut"}, {"5", "force_line"}, {"6", "force_vector"}, {"7", "shape"}, {"8", "ground"}};
   j["cell_fields"] = {"part", "body", "index", "axis", "force", "force_magnitude"};
   j["point_fields"] = {"force_vector"};
   j["axis_length"] = plan.axis_length;

@@ -22,7 +22,8 @@ struct AnimationPlan;  // what is drawn, resolved once against the System (anima
 
 // The `part` codes of the cells (cell field "part"), as listed in legend.json.
 enum class AnimationPart {
-  kAxis = 0, kBodyLine = 1, kBodyPoint = 2, kJoint = 3, kCut = 4, kForceLine = 5, kForceVector = 6, kShape = 7
+  kAxis = 0, kBodyLine = 1, kBodyPoint = 2, kJoint = 3, kCut = 4, kForceLine = 5, kForceVector = 6, kShape = 7,
+  kGround = 8  // the ground under a wheel contact: a line of the wheel's diameter at the ground height
 };
 
 class AnimationSink : public Sink {

@@ -7,7 +7,7 @@
 Reads the .pvd collection and its .vtp frames back with VTK's own XML reader (python3-vtk9) and
 draws each frame with matplotlib in a 3D view with fixed axes and the time in the corner: body
 axes (x red, y green, z blue), body lines, joints and cuts, force elements coloured by their
-force, point and contact forces as arrows, shapes as faces. Writes an MP4 (ffmpeg) or, for a
+force, point and contact forces as arrows, the ground under a wheel, shapes as faces. Writes an MP4 (ffmpeg) or, for a
 .gif name, an animated GIF (Pillow). animate() is the same from Python.
 """
 import argparse
@@ -24,7 +24,7 @@ from matplotlib import animation as mpl_animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
 # Cell "part" codes (cases/animation_sink.h, legend.json).
-AXIS, BODY_LINE, BODY_POINT, JOINT, CUT, FORCE_LINE, FORCE_VECTOR, SHAPE = range(8)
+AXIS, BODY_LINE, BODY_POINT, JOINT, CUT, FORCE_LINE, FORCE_VECTOR, SHAPE, GROUND = range(9)
 
 
 def read_pvd(path):
@@ -98,7 +98,8 @@ class _Scene:
         self.body = Line3DCollection([], colors="0.25", lw=1.6)
         self.axes = Line3DCollection([], lw=1.0)
         self.force = Line3DCollection([], cmap="plasma", norm=self.norm, lw=3.0)
-        for a in (self.shapes, self.body, self.axes, self.force):
+        self.ground = Line3DCollection([], colors="saddlebrown", lw=2.5)
+        for a in (self.shapes, self.body, self.axes, self.force, self.ground):
             ax.add_collection3d(a)
         self.joints = ax.scatter([], [], [], s=14, c="k", depthshade=False, label="joints")
         self.cuts = ax.scatter([], [], [], s=22, c="tab:orange", marker="D", depthshade=False, label="cuts")
@@ -109,6 +110,7 @@ class _Scene:
         polys = frame["polys"]
         self.shapes.set_verts([frame["points"][ids] for ids in polys["ids"]])
         self.body.set_segments(_lines(frame, BODY_LINE)[0])
+        self.ground.set_segments(_lines(frame, GROUND)[0])
         axes, keep = _lines(frame, AXIS)
         self.axes.set_segments(axes)
         self.axes.set_color([("tab:red", "tab:green", "tab:blue")[int(frame["lines"]["axis"][k])] for k in keep])
@@ -153,8 +155,8 @@ def animate(pvd, out, fps=None, start=None, end=None, max_frames=None, size=(640
         ax.set_title(title)
     scene = _Scene(ax, frames, lo, hi)
     if scene.norm.vmax > 0:
-        fig.colorbar(scene.force, ax=ax, shrink=0.5, pad=0.1, label="|force| [N]")
-    fig.subplots_adjust(left=0, right=1, bottom=0.02, top=0.98)
+        fig.colorbar(scene.force, ax=ax, shrink=0.5, pad=0.12, label="|force| [N]")
+    fig.subplots_adjust(left=0, right=0.95, bottom=0.02, top=0.92 if title else 0.98)
     writer = mpl_animation.PillowWriter(fps=fps) if out.lower().endswith(".gif") else \
         mpl_animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
     with writer.saving(fig, out, dpi=dpi):
