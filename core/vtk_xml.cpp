@@ -1,6 +1,7 @@
 #include "core/vtk_xml.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -59,7 +60,13 @@ class AtomicFile {
 void write_doubles(std::FILE* f, const std::vector<double>& v, const char* name, int components) {
   std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"ascii\">\n",
                name, components);
-  for (size_t k = 0; k < v.size(); ++k) std::fprintf(f, k % 3 == 2 ? "%.17g\n" : "%.17g ", v[k]);
+  char buf[40];
+  for (size_t k = 0; k < v.size(); ++k) {
+    // The shortest text that reads back as the same double (std::to_chars without a precision).
+    char* end = std::to_chars(buf, buf + sizeof buf - 1, v[k]).ptr;
+    *end++ = k % 3 == 2 ? '\n' : ' ';
+    std::fwrite(buf, 1, end - buf, f);
+  }
   std::fprintf(f, "\n        </DataArray>\n");
 }
 

@@ -1,6 +1,6 @@
 // A small writer of VTK's XML PolyData (.vtp) and ParaView data collection (.pvd) files, the
 // documented formats of https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html.
-// ASCII, every number with 17 significant digits (an exact round trip of doubles). Each file is
+// ASCII, every number as the shortest text that reads back as the same double (std::to_chars). Each file is
 // written to NAME.tmp and renamed, so a reader never sees a half-written file.
 // Why not the VTK library: docs/animation.md ("Writer").
 #pragma once
