@@ -8,7 +8,7 @@ Reads the .pvd collection and its .vtp frames back with VTK's own XML reader (py
 draws each frame with matplotlib in a 3D view with fixed axes and the time in the corner: body
 axes (x red, y green, z blue), body lines, joints and cuts, force elements coloured by their
 force, point and contact forces as arrows, the ground under a wheel, shapes as faces. Writes an MP4 (ffmpeg) or, for a
-.gif name, an animated GIF (Pillow). animate() is the same from Python.
+.gif name, an animated GIF (Pillow). animate() and animation() are the same from Python.
 """
 import argparse
 import json
@@ -165,6 +165,17 @@ def animate(pvd, out, fps=None, start=None, end=None, max_frames=None, size=(640
             writer.grab_frame()
     plt.close(fig)
     return len(frames)
+
+
+def animation(source, out, **options):
+    """`source`: a run folder holding animation.pvd (written by --animation or an AnimationSink),
+    or the .pvd itself. Draws it into `out` (.mp4 or .gif) with animate(**options); returns `out`.
+    This is what the Python package's Result.animation(out, ...) calls."""
+    pvd = os.path.join(source, "animation.pvd") if os.path.isdir(source) else source
+    if not os.path.isfile(pvd):
+        raise FileNotFoundError(f"{pvd}: no animation (run with --animation, or with an AnimationSink)")
+    animate(pvd, out, **options)
+    return out
 
 
 def main():

@@ -181,3 +181,13 @@ def test_video_has_the_frames_and_size_asked_for(dynamics, tmp_path):
     from PIL import Image
     with Image.open(gif) as im:
         assert (im.n_frames, im.size) == (sum(1 for t, _ in video.read_pvd(pvd) if t >= 0.1), (200, 160))
+
+
+def test_animation_of_a_run_folder(dynamics, tmp_path):
+    out = str(tmp_path / "b.gif")
+    assert video.animation(str(dynamics), out, max_frames=3, size=(120, 100)) == out
+    from PIL import Image
+    with Image.open(out) as im:
+        assert (im.n_frames, im.size) == (3, (120, 100))
+    with pytest.raises(FileNotFoundError):
+        video.animation(str(tmp_path), str(tmp_path / "c.gif"))
