@@ -91,7 +91,8 @@ class _Scene:
     def __init__(self, ax, frames, lo, hi):
         self.ax = ax
         forces = [abs(v) for f in frames for v, p in zip(f["lines"]["force"], f["lines"]["part"]) if p == FORCE_LINE]
-        self.norm = matplotlib.colors.Normalize(0, max(forces) if forces else 1.0)
+        self.has_forces = bool(forces) and max(forces) > 0
+        self.norm = matplotlib.colors.Normalize(0, max(forces) if self.has_forces else 1.0)
         vmax = max((np.linalg.norm(f["force_vector"], axis=1).max() for f in frames), default=0.0)
         self.vector_scale = 0.25 * (hi - lo).max() / vmax if vmax > 0 else 0.0
         self.shapes = Poly3DCollection([], facecolor=(0.55, 0.6, 0.7, 0.35), edgecolor=(0.3, 0.3, 0.4, 0.4), lw=0.3)
@@ -154,7 +155,7 @@ def animate(pvd, out, fps=None, start=None, end=None, max_frames=None, size=(640
     if title:
         ax.set_title(title)
     scene = _Scene(ax, frames, lo, hi)
-    if scene.norm.vmax > 0:
+    if scene.has_forces:
         fig.colorbar(scene.force, ax=ax, shrink=0.5, pad=0.12, label="|force| [N]")
     fig.subplots_adjust(left=0, right=0.95, bottom=0.02, top=0.92 if title else 0.98)
     writer = mpl_animation.PillowWriter(fps=fps) if out.lower().endswith(".gif") else \
