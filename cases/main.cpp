@@ -1,113 +1,65 @@
 // mbdae command-line front end:
 //   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT]
 //                         [--formulation index3|index2-ggl|index1|penalty]
-// Exit codes: 0 success, 1 usage, 2 invalid scene, 3 solve failure.
+// Exit codes (docs/errors.md): 0 success, 1 usage, 2 invalid scene, 3 solve failure, 4 output
+// or resource failure (a file that cannot be written, a folder in use, out of memory),
+// 128 + N stopped by signal N (SIGINT 130, SIGTERM 143).
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <memory>
+#include <new>
 #include <string>
 
 #include "cases/animation_sink.h"
+#include "cases/cli_options.h"
 #include "cases/run_scene.h"
 #include "cases/scene.h"
+#include "cases/signals.h"
 #include "core/errors.h"
+#include "core/output.h"
 #include "formulation/system.h"
 
-namespace {
-void usage() {
-  std::fprintf(stderr,
-               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
-               "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
-               "                  [--formulation index3|index2-ggl|index1|penalty]\n"
-               "       mbdae check SCENE.yaml\n");
-}
-bool parse_number(const char* s, double& v) {
-  char* end = nullptr;
-  v = std::strtod(s, &end);
-  return end && *end == '\0' && end != s;
-}
-}  // namespace
-
 int main(int argc, char** argv) {
-  if (argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0)) {
-    usage();
+  mbdae::CommandLine cl;
+  const std::string usage_error = mbdae::parse_command_line(std::vector<std::string>(argv + 1, argv + argc), cl);
+  if (!usage_error.empty()) {
+    std::fprintf(stderr, "mbdae: %s\n", usage_error.c_str());
+    if (cl.show_usage) mbdae::print_usage();
     return 1;
   }
-  const bool check_only = std::strcmp(argv[1], "check") == 0;
-  const std::string scene_path = argv[2];
-  mbdae::RunOptions opt;
-  opt.verbose = true;
-  opt.progress = true;
-  opt.keep_rows = false;
-  bool animation = false;  // DIR/animation.pvd (cases/animation_sink.h)
-  double animation_rate = 0;
-  for (int i = 3; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      opt.out_dir = argv[++i];
-    } else if ((a == "--rtol" || a == "--atol") && i + 1 < argc) {
-      double v;
-      if (!parse_number(argv[++i], v) || !(v > 0) || v > 1) {
-        std::fprintf(stderr, "mbdae: %s expects a number in (0, 1], got '%s'\n", a.c_str(), argv[i]);
-        return 1;
-      }
-      (a == "--rtol" ? opt.rtol : opt.atol) = v;
-    } else if (a == "--output-step" && i + 1 < argc) {
-      double v;
-      if (!parse_number(argv[++i], v) || !(v > 0)) {
-        std::fprintf(stderr, "mbdae: --output-step expects a positive number of seconds, got '%s'\n", argv[i]);
-        return 1;
-      }
-      opt.output_step = v;
-    } else if (a == "--formulation" && i + 1 < argc) {
-      opt.formulation = argv[++i];
-      if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1" &&
-          opt.formulation != "penalty") {
-        std::fprintf(stderr, "mbdae: --formulation expects index3, index2-ggl, index1 or penalty, got '%s'\n",
-                     opt.formulation.c_str());
-        return 1;
-      }
-    } else if (a == "--animation") {
-      animation = true;
-    } else if (a == "--animation-rate" && i + 1 < argc) {
-      if (!parse_number(argv[++i], animation_rate) || !(animation_rate > 0)) {
-        std::fprintf(stderr, "mbdae: --animation-rate expects a positive number of frames per second, got '%s'\n", argv[i]);
-        return 1;
-      }
-      animation = true;
-    } else if (a == "--quiet") {
-      opt.verbose = false;
-      opt.progress = false;
-    } else {
-      std::fprintf(stderr, "mbdae: unknown argument '%s'\n", a.c_str());
-      usage();
-      return 1;
-    }
-  }
-  if (!check_only && opt.out_dir.empty()) {
-    std::fprintf(stderr, "mbdae: --out DIR is required\n");
-    return 1;
-  }
+  mbdae::RunOptions& opt = cl.options;
+  opt.stop = mbdae::install_stop_signals();
   try {
-    const mbdae::Scene scene = mbdae::load_scene(scene_path);
-    if (check_only) {
+    const mbdae::Scene scene = mbdae::load_scene(cl.scene_path);
+    if (cl.check_only) {
       const mbdae::System sys = mbdae::build_system(scene.model);
-      std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", scene_path.c_str(),
+      std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", cl.scene_path.c_str(),
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
-    std::unique_ptr<mbdae::AnimationSink> anim;
-    if (animation || scene.animation.write) anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, animation_rate);
+    const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, opt);
+    for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
+    if (!bad_overrides.empty()) return 1;
+    const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(opt.out_dir, {"results.csv", "summary.json"});
+    std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/animation_sink.h)
+    if (cl.animation || scene.animation.write)
+      anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, cl.animation_rate);
     std::vector<mbdae::Sink*> sinks;
     if (anim) sinks.push_back(anim.get());
-    return mbdae::run(scene, opt, sinks).exit_code;
+    const mbdae::Result r = mbdae::run(scene, opt, sinks);
+    const bool interrupted = r.summary.value("status", std::string()) == "interrupted";
+    return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;
   } catch (const mbdae::SceneError& e) {
     for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());
     return 2;
   } catch (const mbdae::ModelError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
+  } catch (const mbdae::OutputError& e) {
+    std::fprintf(stderr, "mbdae: %s\n", e.what());
+    return 4;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "mbdae: out of memory (the scene or its output needs more memory than is available)\n");
+    return 4;
   } catch (const mbdae::SolveError& e) {
     std::fprintf(stderr, "mbdae: %s\n", e.what());
     return 3;

@@ -188,10 +188,10 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
     steps.push_back(step);
     summary["status"] = status;
     summary["message"] = message;
-    write_summary();
     out.exit_code = 3;
     out.q = q;
     std::fprintf(stderr, "mbdae: %s\n", message.c_str());  // also under --quiet: a failure is always said
+    write_summary();  // last: it may fail too (a full disk), and the message above is said first
   };
 
   for (const AnalysisStep& step : scene.steps) {
@@ -314,6 +314,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         io.atol = opt.atol > 0 ? opt.atol : step.atol;
         io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
         io.max_step = step.max_step;
+        io.stop = opt.stop;
         io.nonlinear_convergence = step.newton_convergence;
         js["newton_convergence"] = io.nonlinear_convergence;
         js["rtol"] = io.rtol;
@@ -370,14 +371,20 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         auto last_print = wall0;
         bool printed = false;
         long rows = 0;
+        std::string output_error;  // a failed write stops the run (status output_failed, exit 4)
         auto output = [&](double t, const double* yy, const double* yyp) {
           max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, yyp, qo, vo, ao, step.output_projection));
           evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];
           if (!opt.out_dir.empty()) {
-            csv.row(row.data());
-            if (++rows % 256 == 0) csv.flush();
+            try {
+              csv.row(row.data());
+              if (++rows % 256 == 0) csv.flush();  // whole rows on disk as the run goes
+            } catch (const OutputError& e) {
+              output_error = e.what();
+              return false;
+            }
           }
           if (opt.keep_rows) out.rows.push_back(row);
           if (!sinks.empty()) {
@@ -403,7 +410,11 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         };
         const IdaStats st = integrate(dae, io, y, yp, output);
         if (printed) std::fprintf(stderr, "\n");
-        csv.close();
+        if (output_error.empty()) try {
+            csv.close();
+          } catch (const OutputError& e) {
+            output_error = e.what();
+          }
         std::copy(y.begin(), y.begin() + sys.nq(), q.begin());
         json stats;
         stats["steps"] = st.steps;
@@ -425,7 +436,7 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
           stats["max_constraint_condition"] = dae.max_condition;
           stats["max_constraint_condition_time"] = dae.max_condition_time;
         }
-        stats["output_rows"] = out.rows.size() ? static_cast<long>(out.rows.size()) : rows;
+        stats["output_rows"] = out.rows.size() ? static_cast<long>(out.rows.size()) : csv.rows();
         js["statistics"] = stats;
         js["event_times"] = st.event_times;
         js["breakpoint_times"] = st.breakpoint_times;
@@ -440,6 +451,15 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
                       "cpu %.3f s, max constraint violation %.2e\n",
                       js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
                       st.event_times.size(), st.cpu_seconds, dae.max_position_violation);
+        if (!output_error.empty()) {
+          fail("output_failed", output_error, js);
+          out.exit_code = 4;
+          return false;
+        }
+        if (st.ok && opt.stop && opt.stop->load() && st.t_reached < step.t_end) {
+          fail("interrupted", "interrupted at t = " + std::to_string(st.t_reached), js);
+          return false;
+        }
         if (!st.ok) {
           // The last configuration reached and, if the constraint Jacobian is singular there,
           // why the run cannot go on (a drive past the mechanism's travel, a dead centre).

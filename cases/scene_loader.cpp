@@ -13,8 +13,10 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
+#include "cases/field_ranges.h"
 #include "cases/scene.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
@@ -32,8 +34,7 @@ SceneError::SceneError(std::vector<std::string> m)
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-constexpr std::size_t kMaxFileBytes = 16u << 20;  // scene and model files
-constexpr double kMaxOutputRows = 1e8;
+constexpr double kDefaultMaxFileMB = 16;  // scene and model files; MBDAE_MAX_SCENE_MB changes it
 
 using Fields = std::vector<std::string>;
 
@@ -69,12 +70,6 @@ std::string describe(const YAML::Node& n) {
   if (n.IsSequence()) return "a list of " + std::to_string(n.size());
   return quote(n.Scalar());
 }
-std::string format_number(double x) {
-  std::ostringstream os;
-  os << x;
-  return os.str();
-}
-
 struct Loader {
   std::string file;
   std::vector<SceneIssue>* issues;
@@ -747,16 +742,11 @@ struct Loader {
       error(at(n, "t_end"), "t_end", "the time span is empty (t_end " + format_number(s.t_end) +
                                          " must exceed t0 " + format_number(s.t0) + ")");
     if (integrates && (output_step || !has(n, "output_step"))) {
-      if (!(s.output_step > 0))
-        error(at(n, "output_step"), "output_step", "must be positive, got " + format_number(s.output_step));
-      else if (times_ok && s.t_end > s.t0 && (s.t_end - s.t0) / s.output_step > kMaxOutputRows)
-        error(at(n, "output_step"), "output_step", "too small: more than 1e8 output rows over [" +
-                                                       format_number(s.t0) + ", " + format_number(s.t_end) + "]");
+      const std::string why = output_step_range_error(s.output_step, times_ok ? s.t0 : 0, times_ok ? s.t_end : 0);
+      if (!why.empty()) error(at(n, "output_step"), "output_step", why);
     }
-    if (rtol && !(s.rtol >= 1e-14 && s.rtol <= 0.5))
-      error(n["rtol"], "rtol", "out of range [1e-14, 0.5], got " + format_number(s.rtol));
-    if (atol && !(s.atol > 0 && s.atol <= 1.0))
-      error(n["atol"], "atol", "out of range (0, 1], got " + format_number(s.atol));
+    if (rtol && !rtol_range_error(s.rtol).empty()) error(n["rtol"], "rtol", rtol_range_error(s.rtol));
+    if (atol && !atol_range_error(s.atol).empty()) error(n["atol"], "atol", atol_range_error(s.atol));
     if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
@@ -832,22 +822,34 @@ struct Loader {
       }
       for (const auto& item : list) fn(item);
     };
-    auto replace = [&](auto& vec, size_t before, std::set<std::string>& added_here, const char* what) {
+    // A scene item replaces the model's item of its name (found through a name -> index map, so
+    // that loading stays linear in the number of items); two of one name in this file are an error.
+    struct Names {
+      std::set<std::string> added_here;
+      std::unordered_map<std::string, size_t> index;  // first item of each name
+      bool built = false;
+    };
+    auto replace = [&](auto& vec, size_t before, Names& names, const char* what) {
       if (!patch || vec.size() == before) return;
-      auto added = vec.back();
+      if (!names.built) {
+        for (size_t k = 0; k < before; ++k) names.index.emplace(vec[k].name, k);
+        names.built = true;
+      }
+      auto added = std::move(vec.back());
       vec.pop_back();
-      if (!added.name.empty() && !added_here.insert(added.name).second) {  // keep the first
+      if (!added.name.empty() && !names.added_here.insert(added.name).second) {  // keep the first
         error_at(lines->line(added.where, "name"), "name", std::string(what) + " " + quote(added.name) + " is defined twice in this file");
         return;
       }
-      for (auto& e : vec)
-        if (e.name == added.name) {
-          e = added;
-          return;
-        }
-      vec.push_back(added);
+      const auto it = names.index.find(added.name);
+      if (it != names.index.end()) {
+        vec[it->second] = std::move(added);
+        return;
+      }
+      names.index.emplace(added.name, vec.size());
+      vec.push_back(std::move(added));
     };
-    std::set<std::string> b_names, j_names, c_names, f_names, s_names;
+    Names b_names, j_names, c_names, f_names, s_names;
     each("bodies", [&](const YAML::Node& n) { size_t b = m.bodies.size(); body(n, m); replace(m.bodies, b, b_names, "body"); });
     each("joints", [&](const YAML::Node& n) { size_t b = m.joints.size(); joint(n, m); replace(m.joints, b, j_names, "joint"); });
     each("cuts", [&](const YAML::Node& n) { size_t b = m.cuts.size(); cut(n, m); replace(m.cuts, b, c_names, "cut"); });
@@ -871,8 +873,23 @@ struct Loader {
   }
 };
 
-// Reads a file of at most kMaxFileBytes; on failure returns nullopt and says why.
+// The size limit of scene and model files in MB: MBDAE_MAX_SCENE_MB if set (a positive number),
+// else kDefaultMaxFileMB. Returns 0 (and says why) for a value that is not a positive number.
+double max_file_mb(std::string& why) {
+  const char* s = std::getenv("MBDAE_MAX_SCENE_MB");
+  if (!s) return kDefaultMaxFileMB;
+  char* end = nullptr;
+  const double mb = std::strtod(s, &end);
+  if (*s && end && *end == '\0' && mb > 0 && std::isfinite(mb)) return mb;
+  why = "MBDAE_MAX_SCENE_MB must be a positive number of megabytes, got " + quote(s);
+  return 0;
+}
+
+// Reads a file within the size limit (max_file_mb); on failure returns nullopt and says why.
 std::optional<std::string> read_text_file(const std::string& path, std::string& why) {
+  const double limit_mb = max_file_mb(why);
+  if (limit_mb <= 0) return std::nullopt;
+  const double limit_bytes = limit_mb * 1048576.0;
   std::error_code ec;
   const auto st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st)) {
@@ -892,17 +909,40 @@ std::optional<std::string> read_text_file(const std::string& path, std::string& 
   char buf[65536];
   while (in.read(buf, sizeof buf) || in.gcount() > 0) {
     text.append(buf, static_cast<size_t>(in.gcount()));
-    if (text.size() > kMaxFileBytes) {
-      why = "larger than " + std::to_string(kMaxFileBytes >> 20) + " MB";
+    if (static_cast<double>(text.size()) > limit_bytes) {
+      why = "larger than " + format_number(limit_mb) + " MB; set MBDAE_MAX_SCENE_MB to read larger files";
       return std::nullopt;
     }
   }
   return text;
 }
 
+// The line (1-based) of the '---' that starts the document whose content begins at 0-based line
+// `content` (the last '---' line up to it; the first '---' after line 1 if the document is empty).
+int second_document_line(const std::string& text, int content) {
+  std::istringstream in(text);
+  std::string line;
+  int found = 0;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (content >= 0 && k > content) break;
+    if (line.rfind("---", 0) == 0 && k > 0) {
+      found = k + 1;
+      if (content < 0) break;
+    }
+  }
+  return found;
+}
+
 std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
   try {
-    return YAML::Load(text);
+    // One document per file: a second one (after '---') would be silently ignored by YAML::Load.
+    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    if (docs.size() > 1) {
+      issues.push_back({path, second_document_line(text, docs[1].Mark().line), "",
+                        "a second YAML document ('---') is not read; a scene or model file holds one document"});
+      return std::nullopt;
+    }
+    return docs.empty() ? YAML::Node() : docs[0];
   } catch (const YAML::Exception& e) {
     issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "YAML syntax error: " + e.msg});
     return std::nullopt;

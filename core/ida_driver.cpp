@@ -248,6 +248,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     stats.t_reached = t;
   };
   while (!stop_requested && t < o.t1) {
+    if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
     double tret = t;
     int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
     if (flag < 0) {
