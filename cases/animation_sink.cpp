@@ -301,8 +301,9 @@ AnimationSink::AnimationSink(const Scene& scene, std::string dir, double frame_r
 
 AnimationSink::~AnimationSink() = default;
 
-void AnimationSink::start(const System& sys, double t0, double t_end) {
-  system_ = &sys;
+void AnimationSink::start(std::unique_ptr<System> system, double t0, double t_end) {
+  system_ = std::move(system);
+  const System& sys = *system_;
   plan_ = std::make_unique<AnimationPlan>(make_plan(sys, scene_));
   prepare_folder(dir_);
   const double span = std::min(t_end, spec_.end) - std::max(t0, spec_.start);
@@ -316,7 +317,7 @@ void AnimationSink::start(const System& sys, double t0, double t_end) {
 }
 
 void AnimationSink::begin(const RunInfo& info) {
-  start(*info.system, info.step->t0, info.step->t_end);
+  start(std::make_unique<System>(*info.system), info.step->t0, info.step->t_end);
 }
 
 void AnimationSink::sample(const Sample& s) {
@@ -360,8 +361,8 @@ void AnimationSink::write_collection() { write_pvd(dir_ + "/animation.pvd", entr
 
 // A scene without integration (assembly, equilibrium) is drawn once, at its final configuration.
 void AnimationSink::write_static_frame(const Result& result) {
-  static_system_ = std::make_unique<System>(build_system(scene_.model));
-  System& sys = *static_system_;
+  auto system = std::make_unique<System>(build_system(scene_.model));
+  System& sys = *system;
   if (result.q.size() != static_cast<size_t>(sys.nq())) return;
   const nlohmann::ordered_json steps = result.summary.value("steps", nlohmann::ordered_json::array());
   for (const auto& step : steps) {
@@ -373,7 +374,7 @@ void AnimationSink::write_static_frame(const Result& result) {
     }
   }
   const double t = scene_.steps.empty() ? 0.0 : scene_.steps.back().t0;
-  start(sys, t, t);
+  start(std::move(system), t, t);
   const std::vector<double> v(sys.nq(), 0.0);
   write_frame(t, result.q.data(), v.data(), initial_modes(sys, result.q.data(), t), t);
 }

@@ -39,14 +39,16 @@ class AnimationSink : public Sink {
  private:
   void write_frame(double t, const double* q, const double* v, const std::vector<char>& modes, double input_time);
   void write_collection();
-  void start(const System& sys, double t0, double t_end);
+  void start(std::unique_ptr<System> system, double t0, double t_end);
   void write_static_frame(const Result& result);
 
   const Scene& scene_;
   std::string dir_;
   AnimationSpec spec_;
-  const System* system_ = nullptr;
-  std::unique_ptr<System> static_system_;  // for a scene without integration: one frame at the end
+  // A copy of the run's System as begin() saw it (with parameters solved by an equilibrium): the
+  // run's own is gone when end() draws the last sample. For a scene without integration, the
+  // System built from the scene in end().
+  std::unique_ptr<System> system_;
   std::unique_ptr<AnimationPlan> plan_;
   double frame_step_ = 0, next_time_ = 0;
   std::vector<PvdEntry> entries_;
