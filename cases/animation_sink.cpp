@@ -49,6 +49,7 @@ namespace {
 
 constexpr const char* kFolder = "animation";
 enum CellField { kPart, kBody, kIndex, kAxis, kForce, kForceMagnitude, kNumCellFields };
+const std::vector<std::string> kCellFieldNames = {"part", "body", "index", "axis", "force", "force_magnitude"};
 
 Vec3 world(const PlanPoint& p, const double* q) {
   if (p.host < 0) return p.local;
@@ -266,7 +267,7 @@ nlohmann::ordered_json legend(const AnimationPlan& plan, const System& sys) {
   nlohmann::ordered_json j;
   j["parts"] = {{"0", "axis"}, {"1", "body_line"}, {"2", "body_point"}, {"3", "joint"},
                 {"4", "cut"}, {"5", "force_line"}, {"6", "force_vector"}, {"7", "shape"}, {"8", "ground"}};
-  j["cell_fields"] = {"part", "body", "index", "axis", "force", "force_magnitude"};
+  j["cell_fields"] = kCellFieldNames;
   j["point_fields"] = {"force_vector"};
   j["axis_length"] = plan.axis_length;
   for (const auto& b : plan.bodies) j["bodies"].push_back({{"name", b.name}, {"points", b.point_names}});
@@ -295,7 +296,7 @@ AnimationSink::AnimationSink(const Scene& scene, std::string dir, double frame_r
     : scene_(scene), dir_(std::move(dir)), spec_(scene.animation) {
   if (frame_rate > 0) spec_.frame_rate = frame_rate;
   data_.point_fields = {VtkField{"force_vector", 3, {}}};
-  data_.cell_fields = {"part", "body", "index", "axis", "force", "force_magnitude"};
+  data_.cell_fields = kCellFieldNames;
   for (VtkCells* c : {&data_.verts, &data_.lines, &data_.polys}) c->fields.assign(kNumCellFields, {});
 }
 
