@@ -21,13 +21,11 @@ const std::vector<double>& Result::column(const std::string& name) const {
 }
 
 void set_parameter(Scene& scene, const std::string& path, const std::string& yaml_value) {
-  throw std::logic_error("set_parameter: not implemented yet");
+  scene = reload_scene(scene, {{path, yaml_value}});
 }
 
 Scene with_parameters(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides) {
-  Scene s = scene;
-  for (const auto& [path, value] : overrides) set_parameter(s, path, value);
-  return s;
+  return reload_scene(scene, overrides);
 }
 
 Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks) {

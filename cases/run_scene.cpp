@@ -97,8 +97,14 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     case T::kAxis: return "1";
     case T::kCoordinate: return sys.coordinates[s.target].function.rotation ? "rad" : "m";
     case T::kCoordinateRate: return sys.coordinates[s.target].function.rotation ? "rad/s" : "m/s";
-    case T::kForceLength: return "m";
-    case T::kForceValue: return "N";
+    case T::kForceLength:
+    case T::kForceValue: {  // torques and rotational joint springs measure angles and moments
+      const Force& f = sys.forces[s.target];
+      const bool rotational = f.type == ForceSpec::Type::kTorque ||
+                              (f.type == ForceSpec::Type::kJointSpringDamper && f.coordinate.rotation);
+      if (s.type == T::kForceLength) return rotational ? (f.type == ForceSpec::Type::kTorque ? "1" : "rad") : "m";
+      return rotational ? "N m" : "N";
+    }
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
     case T::kExpression: return "";
@@ -371,10 +377,14 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         auto last_print = wall0;
         bool printed = false;
         long rows = 0;
+        bool first_sample = true;
         std::string output_error;  // a failed write stops the run (status output_failed, exit 4)
         auto output = [&](double t, const double* yy, const double* yyp) {
           max_output_violation = std::fmax(max_output_violation, dae.consistent_output(t, yy, yyp, qo, vo, ao, step.output_projection));
-          evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
+          // Coordinate sensors unwrap against the previous sample (formulation/sensors.h).
+          evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(),
+                           first_sample ? nullptr : sensors.data());
+          first_sample = false;
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];
           if (!opt.out_dir.empty()) {

@@ -1,6 +1,7 @@
 // A scene: a model plus the analyses to run on it, as read from YAML (see docs/scene-format.md).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +36,8 @@ struct AnalysisStep {
   SourceLocation where;
 };
 
+struct SceneSource;  // cases/scene_source.h: the texts it was read from, and its overrides
+
 struct Scene {
   std::string file;
   Model model;
@@ -42,6 +45,8 @@ struct Scene {
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
   std::string redundant_constraints = "remove";  // or "fail"
   AnimationSpec animation;  // cases/animation_spec.h
+  // What the scene was read from (null for a scene built in code), for set_parameter.
+  std::shared_ptr<const SceneSource> source;
 };
 
 // One message per problem found in the scene (file:line: field 'x': ...).
@@ -54,5 +59,8 @@ struct SceneError : std::runtime_error {
 Scene load_scene(const std::string& path);
 // Parses a scene from text (for tests); `path` is used in messages and to resolve includes.
 Scene load_scene_text(const std::string& text, const std::string& path);
+// The scene read again from its source with `overrides` (parameter path, YAML value) added to
+// the ones it has (cases/mbdae.h set_parameter). Throws SceneError as load_scene does.
+Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides);
 
 }  // namespace mbdae

@@ -18,8 +18,11 @@
 
 #include "cases/field_ranges.h"
 #include "cases/scene.h"
+#include "cases/scene_overrides.h"
+#include "cases/scene_source.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
+#include "core/expression.h"
 
 namespace mbdae {
 
@@ -352,20 +355,8 @@ struct Loader {
       error(in, "inertia", "the principal moments violate the triangle inequality (not a rigid body)");
   }
 
-  void body(const YAML::Node& n, Model& m) {
-    if (!check_keys(n, "body", {"name", "mass", "com", "inertia", "points"})) return;
-    BodySpec b;
-    b.where = where(n);
-    b.name = name(n);
-    if (const auto mass = opt_number(n, "mass", true)) {
-      b.mass = *mass;
-      if (!(b.mass > 0)) error(n["mass"], "mass", "must be positive, got " + format_number(b.mass));
-    }
-    b.com = vec3(n, "com", Vec3::Zero());
-    if (has(n, "inertia")) {
-      record(n, "inertia", n["inertia"]);
-      inertia(n["inertia"], b);
-    }
+  // `points: {name: [x, y, z], ...}` of a body or of ground; "origin" and "com" are reserved.
+  void named_points(const YAML::Node& n, std::map<std::string, Vec3>& points) {
     if (has(n, "points")) {
       const YAML::Node pts = n["points"];
       record(n, "points", pts);
@@ -382,7 +373,7 @@ struct Loader {
                                                      : "'origin' is reserved (the origin of the body frame)");
             continue;
           }
-          if (b.points.count(*pname)) {
+          if (points.count(*pname)) {
             error(kv.first, field, "given twice");
             continue;
           }
@@ -392,10 +383,27 @@ struct Loader {
           }
           Vec3 p;
           for (int k = 0; k < 3; ++k) p[k] = to_number(kv.second[k], field).value_or(0.0);
-          b.points[*pname] = p;
+          points[*pname] = p;
         }
       }
     }
+  }
+
+  void body(const YAML::Node& n, Model& m) {
+    if (!check_keys(n, "body", {"name", "mass", "com", "inertia", "points"})) return;
+    BodySpec b;
+    b.where = where(n);
+    b.name = name(n);
+    if (const auto mass = opt_number(n, "mass", true)) {
+      b.mass = *mass;
+      if (!(b.mass > 0)) error(n["mass"], "mass", "must be positive, got " + format_number(b.mass));
+    }
+    b.com = vec3(n, "com", Vec3::Zero());
+    if (has(n, "inertia")) {
+      record(n, "inertia", n["inertia"]);
+      inertia(n["inertia"], b);
+    }
+    named_points(n, b.points);
     m.bodies.push_back(b);
   }
 
@@ -518,10 +526,74 @@ struct Loader {
     m.cuts.push_back(c);
   }
 
+  // A point of a body: a name (of the body's points, "origin", "com") or [x, y, z] in its frame.
+  void body_point(const YAML::Node& n, const char* key, std::string& point, Vec3& xyz, bool& at_xyz) {
+    if (!has(n, key)) return;
+    const YAML::Node v = n[key];
+    record(n, key, v);
+    if (v.IsScalar() && !v.Scalar().empty()) {
+      point = v.Scalar();
+    } else if (v.IsSequence() && v.size() == 3) {
+      xyz = vec3(n, key, Vec3::Zero());
+      at_xyz = true;
+    } else {
+      error(v, key, "expected a point name or [x, y, z], got " + describe(v));
+    }
+  }
+  // A load component: a function of time (number or mapping) or an expression (other text).
+  void load_component(const YAML::Node& n, const char* key, TimeFunction& f, std::string& expression) {
+    if (!has(n, key)) return;
+    const YAML::Node v = n[key];
+    record(n, key, v);
+    if (v.IsScalar()) {
+      const std::string& text = v.Scalar();
+      char* end = nullptr;
+      std::strtod(text.c_str(), &end);
+      const bool number = !text.empty() && end == text.c_str() + text.size() &&
+                          !std::isspace(static_cast<unsigned char>(text[0]));
+      const bool special = !text.empty() && text[0] == '.';  // .nan, .inf: reported as numbers
+      if (!number && !special && !text.empty()) {
+        expression = text;
+        return;
+      }
+    }
+    f = function(v, key);
+  }
+  void three(const YAML::Node& n, const char* key, Vec3& out, const char* unit) {
+    if (!has(n, key)) return;
+    out = vec3(n, key, Vec3::Zero());
+    if (out.minCoeff() < 0) error(n[key], key, std::string("must not be negative (") + unit + ")");
+  }
+  void force_parameters(const YAML::Node& n, ForceSpec& f) {
+    if (!has(n, "parameters")) return;
+    const YAML::Node p = n["parameters"];
+    record(n, "parameters", p);
+    if (!p.IsMap()) {
+      error(p, "parameters", "expected a mapping name: number, got " + describe(p));
+      return;
+    }
+    for (const auto& kv : p) {
+      const auto pname = key_of(kv.first, "parameters");
+      if (!pname) continue;
+      lines->add(f.where, "parameters." + *pname, line_of(kv.first));
+      if (f.parameters.count(*pname)) error(kv.first, "parameters." + *pname, "given twice");
+      else if (f.type != ForceSpec::Type::kUser && Expression::is_reserved(*pname))
+        error(kv.first, "parameters." + *pname, quote(*pname) + " is reserved in expressions (reserved: " +
+                                                    Expression::reserved_list() + ")");
+      else if (const auto x = to_number(kv.second, "parameters." + *pname)) f.parameters[*pname] = *x;
+    }
+  }
+  void frame(const YAML::Node& n, ForceSpec& f) {
+    const std::string fr = text(n, "frame", "world");
+    if (fr == "body") f.body_frame = true;
+    else if (fr != "world" && n["frame"].IsScalar()) error(n["frame"], "frame", "expected world or body, got " + quote(fr));
+  }
+
   void force(const YAML::Node& n, Model& m) {
     static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
                                    "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
-                                   "ground", "law", "parameters"};
+                                   "ground", "law", "parameters", "frame", "torque", "coordinate", "rest",
+                                   "rest_deg", "rotational_stiffness", "rotational_damping"};
     if (!check_keys(n, "force", general)) return;
     ForceSpec f;
     f.where = where(n);
@@ -537,33 +609,67 @@ struct Loader {
       if (x) out = *x;
       if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
     };
+    auto two_points = [&] {
+      f.body1 = name(n, "body1");
+      body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
+      f.body2 = name(n, "body2");
+      body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
+    };
     if (type == "spring_damper") {
       applies(n, "a spring_damper force", general,
               {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"});
       f.type = ForceSpec::Type::kSpringDamper;
-      f.body1 = name(n, "body1");
-      f.point1 = text(n, "point1", "");
-      f.body2 = name(n, "body2");
-      f.point2 = text(n, "point2", "");
+      two_points();
       non_negative("stiffness", f.stiffness, true);
       non_negative("damping", f.damping, false);
       non_negative("free_length", f.free_length, false);
     } else if (type == "point_force") {
-      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz"});
+      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"});
       f.type = ForceSpec::Type::kPointForce;
       f.body1 = name(n, "body");
-      f.point1 = text(n, "point", "");
-      for (const char* key : {"fx", "fy", "fz"})
-        if (has(n, key)) {
-          record(n, key, n[key]);
-          (key[1] == 'x' ? f.fx : key[1] == 'y' ? f.fy : f.fz) = function(n[key], key);
-        }
+      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+      frame(n, f);
+      load_component(n, "fx", f.fx, f.expression[0]);
+      load_component(n, "fy", f.fy, f.expression[1]);
+      load_component(n, "fz", f.fz, f.expression[2]);
+      force_parameters(n, f);
+    } else if (type == "torque") {
+      applies(n, "a torque force", general, {"name", "type", "body", "axis", "frame", "torque", "parameters"});
+      f.type = ForceSpec::Type::kTorque;
+      f.body1 = name(n, "body");
+      frame(n, f);
+      f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
+      if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+      if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
+      load_component(n, "torque", f.fx, f.expression[0]);
+      force_parameters(n, f);
+    } else if (type == "joint_spring_damper") {
+      applies(n, "a joint_spring_damper force", general,
+              {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"});
+      f.type = ForceSpec::Type::kJointSpringDamper;
+      f.coordinate = name(n, "coordinate");
+      non_negative("stiffness", f.stiffness, true);
+      non_negative("damping", f.damping, false);
+      if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
+      if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
+      else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
+    } else if (type == "bushing") {
+      applies(n, "a bushing force", general, {"name", "type", "body1", "point1", "body2", "point2", "stiffness",
+                                               "damping", "rotational_stiffness", "rotational_damping"});
+      f.type = ForceSpec::Type::kBushing;
+      two_points();
+      if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
+        error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
+      three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
+      three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
+      three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
+      three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
     } else if (type == "wheel_contact") {
       applies(n, "a wheel_contact force", general,
               {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"});
       f.type = ForceSpec::Type::kWheelContact;
       f.body1 = name(n, "body");
-      f.point1 = text(n, "point", "");
+      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
       positive("stiffness", f.stiffness);
       positive("radius", f.radius);
       f.axis = vec3(n, "axis", Vec3::UnitY());
@@ -572,38 +678,26 @@ struct Loader {
     } else if (type == "user") {
       applies(n, "a user force", general, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"});
       f.type = ForceSpec::Type::kUser;
-      f.body1 = name(n, "body1");
-      f.point1 = text(n, "point1", "");
-      f.body2 = name(n, "body2");
-      f.point2 = text(n, "point2", "");
+      two_points();
       f.law = name(n, "law");
-      if (has(n, "parameters")) {
-        const YAML::Node p = n["parameters"];
-        record(n, "parameters", p);
-        if (!p.IsMap()) {
-          error(p, "parameters", "expected a mapping name: number, got " + describe(p));
-        } else {
-          for (const auto& kv : p) {
-            const auto pname = key_of(kv.first, "parameters");
-            if (!pname) continue;
-            lines->add(f.where, "parameters." + *pname, line_of(kv.first));
-            if (f.parameters.count(*pname)) error(kv.first, "parameters." + *pname, "given twice");
-            else if (const auto x = to_number(kv.second, "parameters." + *pname)) f.parameters[*pname] = *x;
-          }
-        }
-      }
+      force_parameters(n, f);
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown force type " + quote(type) + " (spring_damper, point_force, wheel_contact, user)");
+      error(n["type"], "type", "unknown force type " + quote(type) +
+                                   " (spring_damper, point_force, torque, joint_spring_damper, bushing, "
+                                   "wheel_contact, user)");
     }
     m.forces.push_back(f);
   }
 
   void sensor(const YAML::Node& n, Model& m) {
-    static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression"};
+    static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression", "wrap"};
     if (!check_keys(n, "sensor", general)) return;
     SensorSpec s;
     s.where = where(n);
     s.name = name(n);
+    if (Expression::is_reserved(s.name))
+      error(n["name"], "name", quote(s.name) + " is reserved in expressions (reserved: " + Expression::reserved_list() +
+                                   "); choose another sensor name");
     const std::string type = text(n, "type", "", true);
     using T = SensorSpec::Type;
     static const std::map<std::string, T> types = {
@@ -630,7 +724,7 @@ struct Loader {
       case T::kPosition: case T::kVelocity: case T::kAcceleration:
         applies(n, what, general, {"name", "type", "body", "point", "component"});
         s.body = name(n, "body");
-        s.point = text(n, "point", "");
+        body_point(n, "point", s.point, s.xyz, s.at_xyz);
         s.component = axis_component(n, "component");
         break;
       case T::kAxis:
@@ -641,8 +735,14 @@ struct Loader {
         s.component = axis_component(n, "component");
         break;
       case T::kCoordinate: case T::kCoordinateRate:
-        applies(n, what, general, {"name", "type", "coordinate"});
+        applies(n, what, general, {"name", "type", "coordinate", "wrap"});
         s.target = name(n, "coordinate");
+        if (has(n, "wrap")) {
+          const std::string w = text(n, "wrap", "false");
+          if (w == "true") s.wrap = true;
+          else if (w != "false" && n["wrap"].IsScalar()) error(n["wrap"], "wrap", "expected true or false, got " + quote(w));
+          if (s.type == T::kCoordinateRate) error(n["wrap"], "wrap", "does not apply to a coordinate_rate sensor (rates are not wrapped)");
+        }
         break;
       case T::kForceLength: case T::kForceValue:
         applies(n, what, general, {"name", "type", "force"});
@@ -813,6 +913,12 @@ struct Loader {
   void sections(const YAML::Node& root, Model& m, bool patch) {
     if (has(root, "name")) m.name = text(root, "name", m.name);
     if (has(root, "gravity")) m.gravity = vec3(root, "gravity", m.gravity);
+    if (has(root, "ground") && check_keys(root["ground"], "ground", {"points"})) {
+      record(root, "ground", root["ground"]);
+      std::map<std::string, Vec3> points;
+      named_points(root["ground"], points);
+      for (const auto& [pname, xyz] : points) m.ground_points[pname] = xyz;  // the scene's replace the model's
+    }
     auto each = [&](const char* key, auto&& fn) {
       if (!has(root, key)) return;
       const YAML::Node list = root[key];
@@ -949,10 +1055,13 @@ std::optional<YAML::Node> parse(const std::string& text, const std::string& path
   }
 }
 
-// Loads into `scene`; returns false if the scene could not be read far enough to be validated.
-bool load(const std::string& text, const std::string& path, Scene& scene, std::vector<SceneIssue>& issues,
-          FieldLines& lines) {
-  const auto parsed = parse(text, path, issues);
+// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
+// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
+// the scene could not be read far enough to be validated.
+bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
+          std::vector<OverrideTarget>& targets) {
+  const std::string& path = src.path;
+  const auto parsed = parse(src.text, path, issues);
   if (!parsed) return false;
   const YAML::Node root = *parsed;
   Loader scene_loader{path, &issues, &lines};
@@ -962,33 +1071,38 @@ bool load(const std::string& text, const std::string& path, Scene& scene, std::v
     return false;
   }
   lines.scene_root = scene_loader.where(root);
-  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                          "forces", "sensors", "remove", "analysis", "output",
-                                          "redundant_constraints", "animation"});
   bool complete = true;
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
   if (scene_loader.has(root, "model")) {
     const std::string model = scene_loader.name(root, "model");
     if (model.empty()) {
       complete = false;
     } else {
-      const std::string model_path = (std::filesystem::path(path).parent_path() / model).string();
+      model_path = (std::filesystem::path(path).parent_path() / model).string();
       std::string why;
-      const auto model_text = read_text_file(model_path, why);
-      std::optional<YAML::Node> mroot;
+      auto known = src.models.find(model_path);
+      const auto model_text = known != src.models.end() ? std::optional<std::string>(known->second)
+                                                        : read_text_file(model_path, why);
       if (!model_text) scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
-      else mroot = parse(*model_text, model_path, issues);
-      if (!mroot) {
-        complete = false;
-      } else {
-        Loader model_loader{model_path, &issues, &lines};
-        if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
-                                                      "forces", "sensors", "animation"})) {
-          model_loader.sections(*mroot, scene.model, false);
-          if (model_loader.has(*mroot, "animation")) model_loader.animation((*mroot)["animation"], scene.animation);
-        }
-        else
-          complete = false;
-      }
+      else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
+      if (!mroot) complete = false;
+    }
+  }
+  if (!complete && !src.overrides.empty()) return false;
+  for (const auto& [p, v] : src.overrides)
+    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
+  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
+                                          "forces", "sensors", "remove", "analysis", "output",
+                                          "redundant_constraints", "animation"});
+  if (mroot) {
+    Loader model_loader{model_path, &issues, &lines};
+    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
+                                                  "forces", "sensors", "animation"})) {
+      model_loader.sections(*mroot, scene.model, false);
+      if (model_loader.has(*mroot, "animation")) model_loader.animation((*mroot)["animation"], scene.animation);
+    } else {
+      complete = false;
     }
   }
   scene_loader.sections(root, scene.model, true);
@@ -1059,20 +1173,41 @@ std::vector<std::string> messages(const std::vector<SceneIssue>& issues) {
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& path) {
+// Loads a scene from its source; issues at an override's place say which parameter set it.
+Scene load_source(SceneSource src) {
   Scene scene;
-  scene.file = path;
+  scene.file = src.path;
   std::vector<SceneIssue> issues;
+  std::vector<OverrideTarget> targets;
   FieldLines lines;
   bool complete = false;
   try {
-    complete = load(text, path, scene, issues, lines);
+    complete = load(src, scene, issues, lines, targets);
   } catch (const YAML::Exception& e) {  // a node shape the loader did not expect
-    issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "cannot read the scene: " + e.msg});
+    issues.push_back({src.path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "cannot read the scene: " + e.msg});
   }
   if (complete) validate_scene(scene, lines, issues);
+  for (auto& i : issues)
+    for (const auto& t : targets)
+      if (i.file == t.file && i.line == t.line) i.message += " (set by parameter " + t.path + " = " + quote(t.value) + ")";
   if (!issues.empty()) throw SceneError(messages(issues));
+  scene.source = std::make_shared<const SceneSource>(std::move(src));
   return scene;
+}
+
+Scene load_scene_text(const std::string& text, const std::string& path) {
+  SceneSource src;
+  src.path = path;
+  src.text = text;
+  return load_source(std::move(src));
+}
+
+Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides) {
+  if (!scene.source)
+    throw SceneError({ModelError::format(scene.file, 0, "", "this scene was not loaded from YAML; it has no parameters to set")});
+  SceneSource src = *scene.source;
+  src.overrides.insert(src.overrides.end(), overrides.begin(), overrides.end());
+  return load_source(std::move(src));
 }
 
 Scene load_scene(const std::string& path) {

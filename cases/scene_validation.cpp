@@ -123,6 +123,12 @@ struct Validator {
     return "no body named '" + name + "'" + suggestion(name, body_names());
   }
 
+  std::string ground_points_text() const {
+    std::string list = "origin";
+    for (const auto& kv : m.ground_points) list += ", " + kv.first;
+    return "its points: " + list + "; name more under ground: {points: ...}";
+  }
+
   // A body and one of its points: "" or "origin" (the body frame's origin), "com", or a named
   // point. Ground has only its origin.
   void check_point(const SourceLocation& w, const std::string& who, const std::string& body_field,
@@ -134,7 +140,9 @@ struct Validator {
     }
     if (point.empty() || point == "origin") return;
     if (body == kGround) {
-      report(w, point_field, who + "ground has no named points (only 'origin')");
+      if (!m.ground_points.count(point))
+        report(w, point_field, who + "ground has no point '" + point + "' (" + ground_points_text() +
+                                   "); expected a point name or [x, y, z]" + suggestion(point, keys(m.ground_points)));
       return;
     }
     if (point == "com") return;
@@ -145,8 +153,8 @@ struct Validator {
     std::string list;
     for (size_t k = 0; k < names.size() && k < 12; ++k) list += (k ? ", " : "") + names[k];
     if (names.size() > 12) list += ", ...";
-    report(w, point_field, who + "body '" + body + "' has no point '" + point + "' (its points: " + list + ")" +
-                               suggestion(point, names));
+    report(w, point_field, who + "body '" + body + "' has no point '" + point + "' (its points: " + list +
+                               "); expected a point name or [x, y, z]" + suggestion(point, names));
   }
 
   void check_bodies() {
@@ -208,7 +216,10 @@ struct Validator {
       }
       if (!j.anchor_point.empty() && !j.parent.empty()) {
         if (j.parent == kGround) {
-          report(j.where, "anchor", who + "ground has no named points; give the anchor as [x, y, z]");
+          if (!m.ground_points.count(j.anchor_point))
+            report(j.where, "anchor", who + "ground has no point '" + j.anchor_point + "' (" + ground_points_text() +
+                                          "); expected a point name or [x, y, z]" +
+                                          suggestion(j.anchor_point, keys(m.ground_points)));
         } else if (bodies.count(j.parent) && j.parent != j.child) {
           const BodySpec& p = *bodies.at(j.parent);
           if (!p.points.count(j.anchor_point)) {
@@ -342,9 +353,24 @@ struct Validator {
           check_point(f.where, who, "body1", f.body1, "point1", f.point1);
           check_point(f.where, who, "body2", f.body2, "point2", f.point2);
           break;
+        case ForceSpec::Type::kBushing:
+          check_point(f.where, who, "body1", f.body1, "point1", f.point1);
+          check_point(f.where, who, "body2", f.body2, "point2", f.point2);
+          if (!f.body1.empty() && !f.body2.empty() && known_body(f.body1) && known_body(f.body2) &&
+              same_rigid_body(f.body1, f.body2))
+            report(f.where, "body2", who + "a bushing between two parts of the same rigid body");
+          break;
         case ForceSpec::Type::kPointForce:
         case ForceSpec::Type::kWheelContact:
+        case ForceSpec::Type::kTorque:
           check_point(f.where, who, "body", f.body1, "point", f.point1);
+          break;
+        case ForceSpec::Type::kJointSpringDamper:
+          if (!f.coordinate.empty() && !joint_of_coordinate.count(f.coordinate))
+            report(f.where, "coordinate", who + "no joint coordinate named '" + f.coordinate + "'" +
+                                              suggestion(f.coordinate, keys(joint_of_coordinate)));
+          else if (tree.merged_coordinates.count(f.coordinate))
+            report(f.where, "coordinate", who + "coordinate '" + f.coordinate + "' belongs to a locked joint (merged)");
           break;
       }
       if (f.type == ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&

@@ -51,6 +51,8 @@ Constraint hold_constraint(const System& sys, int k, double value) {
   c.bi = jc.function.body_parent;
   c.bj = jc.function.body_child;
   c.target = TimeFunction::constant(value);
+  c.owner = Constraint::Owner::kHold;
+  c.owner_name = jc.name;
   c.label = "hold " + jc.name;
   return c;
 }

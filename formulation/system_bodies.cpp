@@ -128,6 +128,8 @@ void merge_locked_joints(const ModelIndex& index, System& sys) {
   for (int b = 0; b < sys.num_bodies(); ++b) {
     Constraint c;
     c.type = Constraint::Type::kNorm;
+    c.owner = Constraint::Owner::kNorm;
+    c.owner_name = sys.bodies[b].name;
     c.bi = b;
     c.label = "body " + sys.bodies[b].name + ": Euler parameter norm";
     sys.constraints.push_back(c);

@@ -17,6 +17,8 @@ void add_cut_constraints(const ModelIndex& index, System& sys) {
     if (f1->body == f2->body)
       fail(cut.where, "body2", "cut '" + cut.name + "' joins two parts of the same rigid body");
     auto add = [&](Constraint c, const std::string& what) {
+      c.owner = Constraint::Owner::kCut;
+      c.owner_name = cut.name;
       c.label = "cut " + cut.name + ": " + what;
       sys.constraints.push_back(c);
     };

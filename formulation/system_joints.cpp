@@ -141,7 +141,13 @@ void add_joint_constraints(const ModelIndex& index, System& sys) {
     base.anchor = fp.local_point(index.anchor_of(j));
     base.origin = fc.local_point(Vec3::Zero());
     add_chain_coordinates(index, j, parts, base, merged, coordinate_names, sys);
-    if (!merged) add_chain_constraints(j, parts, base, sys);
+    if (merged) continue;
+    const size_t first = sys.constraints.size();
+    add_chain_constraints(j, parts, base, sys);
+    for (size_t k = first; k < sys.constraints.size(); ++k) {
+      sys.constraints[k].owner = Constraint::Owner::kJoint;
+      sys.constraints[k].owner_name = j.name;
+    }
   }
   // Locked and driven coordinates of joints that were not merged.
   for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
@@ -149,9 +155,11 @@ void add_joint_constraints(const ModelIndex& index, System& sys) {
     if (jc.merged || jc.spec.mode == CoordinateSpec::Mode::kFree) continue;
     Constraint c = hold_constraint(sys, k, jc.spec.initial);
     if (jc.spec.mode == CoordinateSpec::Mode::kDriven) {
+      c.owner = Constraint::Owner::kDrive;
       c.target = jc.spec.drive;
       c.label = "drive " + jc.name + " = " + jc.spec.drive.describe();
     } else {
+      c.owner = Constraint::Owner::kLock;
       c.label = "lock " + jc.name;
     }
     sys.constraints.push_back(c);

@@ -11,8 +11,7 @@ void fail(const SourceLocation& w, const std::string& field, const std::string& 
 
 Vec3 ModelIndex::anchor_of(const JointSpec& j) const {
   if (j.anchor_point.empty()) return j.anchor;
-  if (j.parent == kGround) fail(j.where, "anchor", "ground has no named points");
-  const auto& pts = bodies.at(j.parent)->points;
+  const auto& pts = j.parent == kGround ? model.ground_points : bodies.at(j.parent)->points;
   auto it = pts.find(j.anchor_point);
   if (it == pts.end())
     fail(j.where, "anchor", "body '" + j.parent + "' has no point '" + j.anchor_point + "'");
@@ -25,7 +24,11 @@ std::pair<const BodyFrame*, Vec3> point_of(const ModelIndex& index, const System
   auto it = sys.frames.find(body);
   if (it == sys.frames.end()) fail(w, field, "no body named '" + body + "'");
   if (point.empty() || point == "origin") return {&it->second, it->second.local_point(Vec3::Zero())};
-  if (body == kGround) fail(w, field, "ground has no named points");
+  if (body == kGround) {
+    auto gp = index.model.ground_points.find(point);
+    if (gp == index.model.ground_points.end()) fail(w, field, "ground has no point '" + point + "'");
+    return {&it->second, gp->second};
+  }
   const BodySpec* b = index.bodies.at(body);
   if (point == "com") return {&it->second, it->second.local_point(b->com)};
   auto pt = b->points.find(point);

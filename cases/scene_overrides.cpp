@@ -1,0 +1,134 @@
+// Parameter overrides on the parsed YAML trees (cases/scene_overrides.h).
+#include "cases/scene_overrides.h"
+
+#include <algorithm>
+#include <cctype>
+#include <vector>
+
+#include "cases/scene.h"
+#include "core/errors.h"
+
+namespace mbdae {
+namespace {
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> out(1);
+  for (char c : path) {
+    if (c == '.') out.emplace_back();
+    else out.back() += c;
+  }
+  return out;
+}
+
+bool is_index(const std::string& s) {
+  return !s.empty() && s.size() < 9 && std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+}
+
+int line_of(const YAML::Node& n) { return n.IsDefined() && n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+
+bool names(const YAML::Node& item, const char* key, const std::string& name) {
+  return item.IsMap() && item[key] && item[key].IsScalar() && item[key].Scalar() == name;
+}
+
+// The index of the item `seg` of a list: by index, by its `name` (analysis steps: by `type`,
+// the first of that type); -1 if none.
+long item_index(const YAML::Node& list, const std::string& seg, bool steps) {
+  if (is_index(seg)) {
+    const long k = std::stol(seg);
+    return k < static_cast<long>(list.size()) ? k : -1;
+  }
+  for (size_t k = 0; k < list.size(); ++k)
+    if (names(list[k], steps ? "type" : "name", seg)) return static_cast<long>(k);
+  return -1;
+}
+
+// The child `seg` of `n` (an undefined node if none). `steps`: n is the analysis section, which
+// may also be a single step written as a mapping.
+YAML::Node child(const YAML::Node& n, const std::string& seg, bool steps) {
+  if (!n.IsDefined()) return YAML::Node(YAML::NodeType::Undefined);
+  if (steps && n.IsMap()) return seg == "0" || names(n, "type", seg) ? n : YAML::Node(YAML::NodeType::Undefined);
+  if (n.IsSequence()) {
+    const long k = item_index(n, seg, steps);
+    return k >= 0 ? YAML::Node(n[k]) : YAML::Node(YAML::NodeType::Undefined);
+  }
+  if (n.IsMap() && n[seg]) return n[seg];
+  return YAML::Node(YAML::NodeType::Undefined);
+}
+
+// Walks `root` along segs[0, count); undefined if a segment is missing.
+YAML::Node walk(YAML::Node root, const std::vector<std::string>& segs, size_t count) {
+  YAML::Node n = root;
+  // reset(), not operator=: assigning to a yaml-cpp handle writes into the node it refers to.
+  for (size_t k = 0; k < count && n.IsDefined(); ++k) n.reset(child(n, segs[k], k == 1 && segs[0] == "analysis"));
+  return n;
+}
+
+// YAML text parsed so that its nodes carry `line` (messages about it name that line).
+YAML::Node parse_at(const std::string& text, int line, const std::string& file, const std::string& path) {
+  try {
+    return YAML::Load(std::string(std::max(0, line - 1), '\n') + text);
+  } catch (const YAML::Exception& e) {
+    throw SceneError({ModelError::format(file, line, path, "the value is not YAML: " + e.msg)});
+  }
+}
+
+}  // namespace
+
+OverrideTarget apply_override(YAML::Node scene, const std::string& scene_file, YAML::Node* model,
+                              const std::string& model_file, const std::string& path, const std::string& value) {
+  const std::vector<std::string> segs = split_path(path);
+  const std::string& last = segs.back();
+  for (const auto& s : segs)
+    if (s.empty()) throw SceneError({ModelError::format(scene_file, 0, path, "not a parameter path (names joined by '.')")});
+  if (segs[0] == "model")
+    throw SceneError({ModelError::format(scene_file, 0, path, "the model file cannot be overridden; load another scene")});
+  const size_t n = segs.size() - 1;
+  const bool last_is_step = n == 1 && segs[0] == "analysis";
+  YAML::Node ps = walk(scene, segs, n), pm = model ? walk(*model, segs, n) : YAML::Node(YAML::NodeType::Undefined);
+  auto has_last = [&](const YAML::Node& p) { return child(p, last, last_is_step).IsDefined(); };
+  // The scene's own item wins (it replaces the model's); coordinates and top-level keys are
+  // merged field by field, so a value given only in the model file is changed there.
+  bool in_scene;
+  if (has_last(ps)) in_scene = true;
+  else if (has_last(pm) && (!ps.IsDefined() || n == 0 || segs[0] == "coordinates")) in_scene = false;
+  else if (ps.IsMap() || ps.IsSequence()) in_scene = true;
+  else if (pm.IsMap() || pm.IsSequence()) in_scene = false;
+  else {
+    // Name the first segment found in neither file.
+    size_t k = 0;
+    while (k < n && (walk(scene, segs, k + 1).IsDefined() || (model && walk(*model, segs, k + 1).IsDefined()))) ++k;
+    std::string where;
+    for (size_t i = 0; i < k; ++i) where += (i ? "." : "") + segs[i];
+    throw SceneError({ModelError::format(scene_file, 0, path,
+                                         "unknown parameter: no item '" + segs[k] + "' in " +
+                                             (where.empty() ? std::string("the scene") : "'" + where + "'") +
+                                             (model ? " (scene or model file)" : ""))});
+  }
+  YAML::Node parent = in_scene ? ps : pm;
+  OverrideTarget t{in_scene ? scene_file : model_file, 0, path, value};
+  if (parent.IsSequence() || (last_is_step && parent.IsMap())) {
+    if (!parent.IsSequence()) {  // a single step written as a mapping: replace its content
+      t.line = line_of(parent);
+      const YAML::Node v = parse_at(value, t.line, t.file, path);
+      if (in_scene) scene["analysis"] = v;
+      return t;
+    }
+    const long k = item_index(parent, last, last_is_step);
+    if (k < 0) throw SceneError({ModelError::format(t.file, line_of(parent), path, "no item '" + last + "' in the list")});
+    t.line = line_of(parent[k]);
+    parent[k] = parse_at(value, t.line, t.file, path);
+  } else if (parent.IsMap()) {
+    if (static_cast<const YAML::Node&>(parent)[last]) {  // const: a lookup must not add the key
+      t.line = line_of(parent[last]);
+      parent[last] = parse_at(value, t.line, t.file, path);
+    } else {
+      t.line = line_of(parent);
+      parent.force_insert(parse_at(last, t.line, t.file, path), parse_at(value, t.line, t.file, path));
+    }
+  } else {
+    throw SceneError({ModelError::format(t.file, line_of(parent), path, "'" + segs[n - 1] + "' has no fields to set")});
+  }
+  return t;
+}
+
+}  // namespace mbdae
