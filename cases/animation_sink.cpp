@@ -9,6 +9,7 @@
 #include "formulation/euler_parameters.h"
 #include "formulation/forces.h"
 #include "formulation/mechanics.h"
+#include "formulation/sensors.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -226,18 +227,24 @@ void draw_constraints(const AnimationPlan& plan, const double* q, Painter& pt) {
             static_cast<int>(c));
 }
 
-// Spring-dampers and user laws as lines carrying their tension; point and contact forces as
-// vectors (point field force_vector) at their points.
+// Spring-dampers, bushings and user laws as lines carrying their force; point and contact forces
+// as vectors (point field force_vector) at their points. Torques and joint springs are not drawn.
 void draw_forces(const System& sys, const double* q, const double* v, const std::vector<char>& modes, double t,
                  Painter& pt) {
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
-    const double value = force_magnitude(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k]);
+    if (f.type == ForceSpec::Type::kTorque || f.type == ForceSpec::Type::kJointSpringDamper) continue;  // no line
+    LoadInput in;
+    if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+    const LocalState x = gather(q, f.bi, f.bj), xd = gather(v, f.bi, f.bj);
+    const double value = force_magnitude(f, x, xd, t, modes[k], &in);
     const Vec3 xi = world({f.bi, f.si}, q);
     const int index = static_cast<int>(k);
     if (f.type == ForceSpec::Type::kPointForce || f.type == ForceSpec::Type::kWheelContact) {
-      const Vec3 vec = f.type == ForceSpec::Type::kPointForce ? Vec3(f.fx.value(t), f.fy.value(t), f.fz.value(t))
-                                                              : Vec3(0, 0, value);
+      // The world force is the translational part of its generalized force on its body.
+      Vec14 generalized = Vec14::Zero();
+      force_eval(f, x, xd, t, modes[k], generalized, nullptr, nullptr, &in);
+      const Vec3 vec = f.type == ForceSpec::Type::kPointForce ? Vec3(generalized.head<3>()) : Vec3(0, 0, value);
       pt.cell(pt.data.verts, {pt.add_point(xi, vec)}, AnimationPart::kForceVector, -1, index, -1, value);
       if (f.type == ForceSpec::Type::kWheelContact) {
         const Vec3 below(xi.x(), xi.y(), f.ground.value(t));
