@@ -1,5 +1,5 @@
 // The command line of mbdae (cases/main.cpp):
-//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet]
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet] [--error-estimate]
 //                         [--formulation index3|index2-ggl|index1|penalty]
 //                         [--animation] [--animation-rate HZ]
 //   mbdae check SCENE.yaml
@@ -20,6 +20,7 @@ struct CommandLine {
   std::string scene_path;
   RunOptions options;
   bool show_usage = false;  // after an error: the usage text helps
+  bool error_estimate = false;  // --error-estimate (cases/error_estimate.h)
   bool animation = false;     // --animation: DIR/animation.pvd (cases/animation_sink.h)
   double animation_rate = 0;  // --animation-rate HZ (implies --animation)
 };

@@ -11,6 +11,7 @@
 
 #include "cases/animation_sink.h"
 #include "cases/cli_options.h"
+#include "cases/error_estimate.h"
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "cases/signals.h"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
     const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(opt.out_dir, {"results.csv", "summary.json"});
+    if (cl.error_estimate || mbdae::error_estimate_requested(scene)) return mbdae::run_with_error_estimate(scene, opt);
     std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/animation_sink.h)
     if (cl.animation || scene.animation.write)
       anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, cl.animation_rate);
