@@ -7,18 +7,22 @@
 #include <cstring>
 #include <string>
 
-#include "cases/run_scene.h"
-#include "cases/scene.h"
+#include "cases/mbdae.h"
+#include "cases/sinks.h"
 #include "core/errors.h"
+#include "core/output.h"
+#include "formulation/formulation_registry.h"
 #include "formulation/system.h"
 
 namespace {
 void usage() {
+  std::string names;  // the registered formulations, index3|index2-ggl|...
+  for (const std::string& f : mbdae::formulations()) names += (names.empty() ? "" : "|") + f;
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
                "                  [--output-step DT]\n"
-               "                  [--formulation index3|index2-ggl|index1|penalty]\n"
-               "       mbdae check SCENE.yaml\n");
+               "                  [--formulation %s]\n"
+               "       mbdae check SCENE.yaml\n", names.c_str());
 }
 bool parse_number(const char* s, double& v) {
   char* end = nullptr;
@@ -37,11 +41,11 @@ int main(int argc, char** argv) {
   mbdae::RunOptions opt;
   opt.verbose = true;
   opt.progress = true;
-  opt.keep_rows = false;
+  std::string out_dir;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc) {
-      opt.out_dir = argv[++i];
+      out_dir = argv[++i];
     } else if ((a == "--rtol" || a == "--atol") && i + 1 < argc) {
       double v;
       if (!parse_number(argv[++i], v) || !(v > 0) || v > 1) {
@@ -58,9 +62,8 @@ int main(int argc, char** argv) {
       opt.output_step = v;
     } else if (a == "--formulation" && i + 1 < argc) {
       opt.formulation = argv[++i];
-      if (opt.formulation != "index3" && opt.formulation != "index2-ggl" && opt.formulation != "index1" &&
-          opt.formulation != "penalty") {
-        std::fprintf(stderr, "mbdae: --formulation expects index3, index2-ggl, index1 or penalty, got '%s'\n",
+      if (!mbdae::find_formulation(opt.formulation)) {
+        std::fprintf(stderr, "mbdae: --formulation expects %s, got '%s'\n", mbdae::formulation_names(true).c_str(),
                      opt.formulation.c_str());
         return 1;
       }
@@ -73,7 +76,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!check_only && opt.out_dir.empty()) {
+  if (!check_only && out_dir.empty()) {
     std::fprintf(stderr, "mbdae: --out DIR is required\n");
     return 1;
   }
@@ -85,8 +88,10 @@ int main(int argc, char** argv) {
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
-    const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
-    return r.exit_code;
+    mbdae::prepare_output_folder(out_dir);
+    mbdae::CsvSink csv(out_dir + "/results.csv");
+    mbdae::SummarySink summary(out_dir + "/summary.json");
+    return mbdae::run(scene, opt, {&csv, &summary}).exit_code;
   } catch (const mbdae::SceneError& e) {
     for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());
     return 2;

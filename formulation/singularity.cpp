@@ -115,7 +115,7 @@ SingularityReport diagnose_singularity(const System& sys, const double* q, doubl
   if (report.rank < nc) {
     // Exactly dependent: name the equations the redundancy check would remove.
     System copy = sys;
-    const RedundancyReport rr = find_redundant_constraints(copy, q, t, false);
+    const RedundancyReport rr = find_redundant_constraints(copy, q, t);
     for (const auto& r : rr.redundant) report.dependent.push_back({r, 1.0});
   } else {
     std::vector<int> idx;

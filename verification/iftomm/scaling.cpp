@@ -194,7 +194,8 @@ Result run_one(int n) {
   }
   res.project_s = cpu_now() - c0;
   c0 = cpu_now();
-  const RedundancyReport rr = find_redundant_constraints(sys, q.data(), 0.0, true);
+  const RedundancyReport rr = find_redundant_constraints(sys, q.data(), 0.0);
+  sys = without_redundant_constraints(sys, rr);
   res.qr_s = cpu_now() - c0;
   res.redundant = static_cast<long>(rr.redundant.size());
   res.equations = sys.num_constraint_rows();
