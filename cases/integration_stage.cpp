@@ -125,6 +125,7 @@ struct Sampler {
     const System& sys = *c.system;
     max_output_violation =
         std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
+    if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
     evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
     row[0] = t;
     for (size_t k = 0; k < c.column_sensors.size(); ++k) row[k + 1] = sensors[c.column_sensors[k]];
@@ -242,6 +243,10 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
                 "cpu %.3f s, max constraint violation %.2e\n",
                 js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
                 st.event_times.size(), st.cpu_seconds, dae->max_position_violation);
+  if (!dae->output_failure.empty()) {
+    fail(c, "output_solve_failed", dae->output_failure, js);
+    return false;
+  }
   if (!sampler.sink_error.empty()) {
     fail(c, "output_failed", sampler.sink_error, js);
     return false;

@@ -33,7 +33,7 @@ struct UserForceLaw {
                      Mat3& df_dd, Mat3& df_dddot)>
       jacobian;  // optional
 };
-void register_force_law(const UserForceLaw& law);
+// The law named `name` from the immutable table in forces.cpp (safe from any thread), or null.
 const UserForceLaw* find_force_law(const std::string& name);
 
 // Generalized force of element f on its (up to two) bodies, local 14-vector; optional exact
