@@ -97,7 +97,7 @@ Costs kernel_costs(const std::string& scene_file) {
   std::copy(pre.q.begin(), pre.q.end(), y.begin());
   dae.modes = initial_modes(sys, y.data(), 0.0);
   dae.consistent_initial_values(0.0, y, yp);
-  dae.output_accelerations = false;  // as run_scene: only for acceleration sensors
+  dae.output_accelerations = false;  // as run(): only for acceleration sensors
   for (const auto& s : sys.sensors)
     if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
   std::vector<double> values(dae.jacobian_pattern().nnz()), q, v, a, s(sys.sensors.size());

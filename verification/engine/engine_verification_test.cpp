@@ -1,5 +1,5 @@
 // End-to-end verification of the engine: scenes in verification/engine/scenes/ are loaded and run
-// as a user runs them (load_scene + run_scene, or the mbdae executable), and their output is
+// as a user runs them (load_scene + run, or the mbdae executable), and their output is
 // compared with references computed here from the scenes' data alone: closed-form solutions, the
 // complete elliptic integral by the arithmetic-geometric mean, energies from the initial joint
 // angles with Eigen's own rotations. No expected value is a recorded output of the engine.

@@ -1,5 +1,5 @@
 // IFToMM / MBSBenchmark problems A01, A02, A04, A05 (verification/iftomm/scenes/) run as a user
-// runs them (load_scene + run_scene) and compared with references that do not come from mbdae:
+// runs them (load_scene + run) and compared with references that do not come from mbdae:
 //   A01  the exact solution of the pendulum (Jacobi sn by the arithmetic-geometric mean);
 //   A02  M theta'' = -C cos(theta), the parallelogram's one-degree-of-freedom equation,
 //        integrated here by RK4 with tiny steps;

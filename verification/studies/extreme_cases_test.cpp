@@ -1,5 +1,5 @@
 // Short versions of the stiff and extreme cases (verification/studies/extreme/*.yaml, documented
-// in docs/extreme-cases.md): the fast scenes run through run_scene, each asserting its documented
+// in docs/extreme-cases.md): the fast scenes run through run(), each asserting its documented
 // outcome. Bounds are the measured values (docs/extreme-cases.md) with a margin of about 3 to 50.
 // A test here failing means the documented outcome changed: update the page (run_extreme.sh)
 // together with the test.
