@@ -78,7 +78,7 @@ FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vect
   // combination (the Euler-parameter norms, bodies' own equations, are left to summary.json).
   std::vector<std::string> named;
   for (const auto& d : r.dependent) {
-    const std::string g = constraint_group(d.label);
+    const std::string& g = d.group;
     if (d.weight < kNamedWeight || g.rfind("body ", 0) == 0) continue;
     if (std::find(named.begin(), named.end(), g) == named.end()) named.push_back(g);
   }

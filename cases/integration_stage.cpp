@@ -37,6 +37,7 @@ IdaOptions integration_options(const RunOptions& opt, const AnalysisStep& step, 
   io.atol = opt.atol > 0 ? opt.atol : step.atol;
   io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
   io.max_step = step.max_step;
+  io.stop = opt.stop;
   io.nonlinear_convergence = step.newton_convergence;
   js["newton_convergence"] = io.nonlinear_convergence;
   js["rtol"] = io.rtol;
@@ -107,6 +108,7 @@ struct Sampler {
   std::vector<double> quiet_ref, quiet_max;
   std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now(), last_print = wall0;
   bool printed = false;
+  bool first_sample = true;
   std::string sink_error;  // a sink's failure (stops the run)
 
   Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, double output_step)
@@ -126,7 +128,10 @@ struct Sampler {
     max_output_violation =
         std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
     if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
-    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data());
+    // Coordinate sensors unwrap against the previous sample (formulation/sensors.h).
+    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(),
+                     first_sample ? nullptr : sensors.data());
+    first_sample = false;
     row[0] = t;
     for (size_t k = 0; k < c.column_sensors.size(); ++k) row[k + 1] = sensors[c.column_sensors[k]];
     for (size_t k = 0; k < row.size(); ++k) c.result.data[k].push_back(row[k]);
@@ -222,6 +227,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
     for (Sink* s : c.sinks) s->begin(info);
   } catch (const std::exception& e) {
     fail(c, "output_failed", e.what(), js);
+    c.result.exit_code = 4;
     return false;
   }
   Sampler sampler(c, step, *dae, io.output_step);
@@ -247,15 +253,16 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
     fail(c, "output_solve_failed", dae->output_failure, js);
     return false;
   }
-  if (!sampler.sink_error.empty()) {
+  if (!sampler.sink_error.empty()) {  // a file that cannot be written: exit code 4 (docs/errors.md)
     fail(c, "output_failed", sampler.sink_error, js);
+    c.result.exit_code = 4;
     return false;
   }
   if (!st.ok) {
     report_failure(c, st, *dae, y, js);
     return false;
   }
-  if (c.options.stop && c.options.stop->load() && st.t_reached < step.t_end) {
+  if (st.ok && c.options.stop && c.options.stop->load() && st.t_reached < step.t_end) {
     fail(c, "interrupted", "interrupted at t = " + std::to_string(st.t_reached), js);
     return false;
   }

@@ -1,103 +1,60 @@
 // mbdae command-line front end:
 //   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT]
 //                         [--formulation index3|index2-ggl|index1|penalty]
-// Exit codes: 0 success, 1 usage, 2 invalid scene, 3 solve failure.
+// Exit codes (docs/errors.md): 0 success, 1 usage, 2 invalid scene, 3 solve failure, 4 output
+// or resource failure (a file that cannot be written, a folder in use, out of memory),
+// 128 + N stopped by signal N (SIGINT 130, SIGTERM 143).
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
+#include <new>
 #include <string>
 
+#include "cases/cli_options.h"
 #include "cases/mbdae.h"
 #include "cases/sinks.h"
+#include "cases/signals.h"
 #include "core/errors.h"
 #include "core/output.h"
-#include "formulation/formulation_registry.h"
 #include "formulation/system.h"
 
-namespace {
-void usage() {
-  std::string names;  // the registered formulations, index3|index2-ggl|...
-  for (const std::string& f : mbdae::formulations()) names += (names.empty() ? "" : "|") + f;
-  std::fprintf(stderr,
-               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
-               "                  [--output-step DT]\n"
-               "                  [--formulation %s]\n"
-               "       mbdae check SCENE.yaml\n", names.c_str());
-}
-bool parse_number(const char* s, double& v) {
-  char* end = nullptr;
-  v = std::strtod(s, &end);
-  return end && *end == '\0' && end != s;
-}
-}  // namespace
-
 int main(int argc, char** argv) {
-  if (argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0)) {
-    usage();
+  mbdae::CommandLine cl;
+  const std::string usage_error = mbdae::parse_command_line(std::vector<std::string>(argv + 1, argv + argc), cl);
+  if (!usage_error.empty()) {
+    std::fprintf(stderr, "mbdae: %s\n", usage_error.c_str());
+    if (cl.show_usage) mbdae::print_usage();
     return 1;
   }
-  const bool check_only = std::strcmp(argv[1], "check") == 0;
-  const std::string scene_path = argv[2];
-  mbdae::RunOptions opt;
-  opt.verbose = true;
-  opt.progress = true;
-  std::string out_dir;
-  for (int i = 3; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out_dir = argv[++i];
-    } else if ((a == "--rtol" || a == "--atol") && i + 1 < argc) {
-      double v;
-      if (!parse_number(argv[++i], v) || !(v > 0) || v > 1) {
-        std::fprintf(stderr, "mbdae: %s expects a number in (0, 1], got '%s'\n", a.c_str(), argv[i]);
-        return 1;
-      }
-      (a == "--rtol" ? opt.rtol : opt.atol) = v;
-    } else if (a == "--output-step" && i + 1 < argc) {
-      double v;
-      if (!parse_number(argv[++i], v) || !(v > 0)) {
-        std::fprintf(stderr, "mbdae: --output-step expects a positive number of seconds, got '%s'\n", argv[i]);
-        return 1;
-      }
-      opt.output_step = v;
-    } else if (a == "--formulation" && i + 1 < argc) {
-      opt.formulation = argv[++i];
-      if (!mbdae::find_formulation(opt.formulation)) {
-        std::fprintf(stderr, "mbdae: --formulation expects %s, got '%s'\n", mbdae::formulation_names(true).c_str(),
-                     opt.formulation.c_str());
-        return 1;
-      }
-    } else if (a == "--quiet") {
-      opt.verbose = false;
-      opt.progress = false;
-    } else {
-      std::fprintf(stderr, "mbdae: unknown argument '%s'\n", a.c_str());
-      usage();
-      return 1;
-    }
-  }
-  if (!check_only && out_dir.empty()) {
-    std::fprintf(stderr, "mbdae: --out DIR is required\n");
-    return 1;
-  }
+  mbdae::RunOptions& opt = cl.options;
+  opt.stop = mbdae::install_stop_signals();
   try {
-    const mbdae::Scene scene = mbdae::load_scene(scene_path);
-    if (check_only) {
+    const mbdae::Scene scene = mbdae::load_scene(cl.scene_path);
+    if (cl.check_only) {
       const mbdae::System sys = mbdae::build_system(scene.model);
-      std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", scene_path.c_str(),
+      std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", cl.scene_path.c_str(),
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
-    mbdae::prepare_output_folder(out_dir);
-    mbdae::CsvSink csv(out_dir + "/results.csv");
-    mbdae::SummarySink summary(out_dir + "/summary.json");
-    return mbdae::run(scene, opt, {&csv, &summary}).exit_code;
+    const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, opt);
+    for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
+    if (!bad_overrides.empty()) return 1;
+    const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(cl.out_dir, {"results.csv", "summary.json"});
+    mbdae::CsvSink csv(cl.out_dir + "/results.csv");
+    mbdae::SummarySink summary(cl.out_dir + "/summary.json");
+    const mbdae::Result r = mbdae::run(scene, opt, {&csv, &summary});  // load, run, write
+    const bool interrupted = r.status == "interrupted";
+    return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;
   } catch (const mbdae::SceneError& e) {
     for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());
     return 2;
   } catch (const mbdae::ModelError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
+  } catch (const mbdae::OutputError& e) {
+    std::fprintf(stderr, "mbdae: %s\n", e.what());
+    return 4;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "mbdae: out of memory (the scene or its output needs more memory than is available)\n");
+    return 4;
   } catch (const mbdae::SolveError& e) {
     std::fprintf(stderr, "mbdae: %s\n", e.what());
     return 3;

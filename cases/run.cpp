@@ -5,6 +5,7 @@
 
 #include "cases/run_stages.h"
 #include "core/errors.h"
+#include "core/output.h"
 #include "formulation/augmented_solver.h"
 #include "formulation/formulation_registry.h"
 #include "formulation/redundancy.h"
@@ -38,8 +39,14 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     case T::kAxis: return "1";
     case T::kCoordinate: return sys.coordinates[s.target].function.rotation ? "rad" : "m";
     case T::kCoordinateRate: return sys.coordinates[s.target].function.rotation ? "rad/s" : "m/s";
-    case T::kForceLength: return "m";
-    case T::kForceValue: return "N";
+    case T::kForceLength:
+    case T::kForceValue: {  // torques and rotational joint springs measure angles and moments
+      const Force& f = sys.forces[s.target];
+      const bool rotational = f.type == ForceSpec::Type::kTorque ||
+                              (f.type == ForceSpec::Type::kJointSpringDamper && f.coordinate.rotation);
+      if (s.type == T::kForceLength) return rotational ? (f.type == ForceSpec::Type::kTorque ? "1" : "rad") : "m";
+      return rotational ? "N m" : "N";
+    }
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
     case T::kExpression: return "";
@@ -135,6 +142,13 @@ void fail(RunContext& c, const std::string& status, const std::string& message, 
   std::fprintf(stderr, "mbdae: %s\n", message.c_str());  // also under --quiet: a failure is always said
 }
 
+void output_failed(RunContext& c, const std::string& message) {
+  std::fprintf(stderr, "mbdae: %s\n", message.c_str());
+  c.result.summary["status"] = c.result.status = "output_failed";
+  c.result.summary["message"] = c.result.message = message;
+  c.result.exit_code = 4;
+}
+
 std::vector<std::string> formulations() {
   std::vector<std::string> names;
   for (const Formulation& f : formulation_registry()) names.push_back(f.name);
@@ -200,7 +214,14 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
     result.status = "ok";
     result.q = c.q;
   }
-  for (Sink* s : sinks) s->end(result);
+  for (Sink* s : sinks) {
+    try {
+      s->end(result);
+    } catch (const OutputError& e) {  // results.csv could not be completed: say so in the summary
+      if (s == sinks.back()) throw;
+      output_failed(c, e.what());
+    }
+  }
   return result;
 }
 

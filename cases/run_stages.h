@@ -41,6 +41,8 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordere
 
 // Records a failed step: its status and message in the step and the summary, exit code 3.
 void fail(RunContext& c, const std::string& status, const std::string& message, nlohmann::ordered_json step);
+// An output (a sink) that failed after the run: status output_failed, exit code 4.
+void output_failed(RunContext& c, const std::string& message);
 // The summary's closing entries (warnings, steps), once the run ends.
 void close_summary(RunContext& c);
 // Joint coordinates and (non-acceleration) sensors at q, for the summary.

@@ -13,13 +13,16 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
+#include "cases/field_ranges.h"
 #include "cases/scene.h"
 #include "cases/scene_overrides.h"
 #include "cases/scene_source.h"
 #include "cases/scene_validation.h"
 #include "core/errors.h"
+#include "core/expression.h"
 #include "formulation/formulation_registry.h"
 
 namespace mbdae {
@@ -35,8 +38,7 @@ SceneError::SceneError(std::vector<std::string> m)
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-constexpr std::size_t kMaxFileBytes = 16u << 20;  // scene and model files
-constexpr double kMaxOutputRows = 1e8;
+constexpr double kDefaultMaxFileMB = 16;  // scene and model files; MBDAE_MAX_SCENE_MB changes it
 
 using Fields = std::vector<std::string>;
 
@@ -72,12 +74,6 @@ std::string describe(const YAML::Node& n) {
   if (n.IsSequence()) return "a list of " + std::to_string(n.size());
   return quote(n.Scalar());
 }
-std::string format_number(double x) {
-  std::ostringstream os;
-  os << x;
-  return os.str();
-}
-
 struct Loader {
   std::string file;
   std::vector<SceneIssue>* issues;
@@ -360,20 +356,8 @@ struct Loader {
       error(in, "inertia", "the principal moments violate the triangle inequality (not a rigid body)");
   }
 
-  void body(const YAML::Node& n, Model& m) {
-    if (!check_keys(n, "body", {"name", "mass", "com", "inertia", "points"})) return;
-    BodySpec b;
-    b.where = where(n);
-    b.name = name(n);
-    if (const auto mass = opt_number(n, "mass", true)) {
-      b.mass = *mass;
-      if (!(b.mass > 0)) error(n["mass"], "mass", "must be positive, got " + format_number(b.mass));
-    }
-    b.com = vec3(n, "com", Vec3::Zero());
-    if (has(n, "inertia")) {
-      record(n, "inertia", n["inertia"]);
-      inertia(n["inertia"], b);
-    }
+  // `points: {name: [x, y, z], ...}` of a body or of ground; "origin" and "com" are reserved.
+  void named_points(const YAML::Node& n, std::map<std::string, Vec3>& points) {
     if (has(n, "points")) {
       const YAML::Node pts = n["points"];
       record(n, "points", pts);
@@ -390,7 +374,7 @@ struct Loader {
                                                      : "'origin' is reserved (the origin of the body frame)");
             continue;
           }
-          if (b.points.count(*pname)) {
+          if (points.count(*pname)) {
             error(kv.first, field, "given twice");
             continue;
           }
@@ -400,10 +384,27 @@ struct Loader {
           }
           Vec3 p;
           for (int k = 0; k < 3; ++k) p[k] = to_number(kv.second[k], field).value_or(0.0);
-          b.points[*pname] = p;
+          points[*pname] = p;
         }
       }
     }
+  }
+
+  void body(const YAML::Node& n, Model& m) {
+    if (!check_keys(n, "body", {"name", "mass", "com", "inertia", "points"})) return;
+    BodySpec b;
+    b.where = where(n);
+    b.name = name(n);
+    if (const auto mass = opt_number(n, "mass", true)) {
+      b.mass = *mass;
+      if (!(b.mass > 0)) error(n["mass"], "mass", "must be positive, got " + format_number(b.mass));
+    }
+    b.com = vec3(n, "com", Vec3::Zero());
+    if (has(n, "inertia")) {
+      record(n, "inertia", n["inertia"]);
+      inertia(n["inertia"], b);
+    }
+    named_points(n, b.points);
     m.bodies.push_back(b);
   }
 
@@ -526,10 +527,74 @@ struct Loader {
     m.cuts.push_back(c);
   }
 
+  // A point of a body: a name (of the body's points, "origin", "com") or [x, y, z] in its frame.
+  void body_point(const YAML::Node& n, const char* key, std::string& point, Vec3& xyz, bool& at_xyz) {
+    if (!has(n, key)) return;
+    const YAML::Node v = n[key];
+    record(n, key, v);
+    if (v.IsScalar() && !v.Scalar().empty()) {
+      point = v.Scalar();
+    } else if (v.IsSequence() && v.size() == 3) {
+      xyz = vec3(n, key, Vec3::Zero());
+      at_xyz = true;
+    } else {
+      error(v, key, "expected a point name or [x, y, z], got " + describe(v));
+    }
+  }
+  // A load component: a function of time (number or mapping) or an expression (other text).
+  void load_component(const YAML::Node& n, const char* key, TimeFunction& f, std::string& expression) {
+    if (!has(n, key)) return;
+    const YAML::Node v = n[key];
+    record(n, key, v);
+    if (v.IsScalar()) {
+      const std::string& text = v.Scalar();
+      char* end = nullptr;
+      std::strtod(text.c_str(), &end);
+      const bool number = !text.empty() && end == text.c_str() + text.size() &&
+                          !std::isspace(static_cast<unsigned char>(text[0]));
+      const bool special = !text.empty() && text[0] == '.';  // .nan, .inf: reported as numbers
+      if (!number && !special && !text.empty()) {
+        expression = text;
+        return;
+      }
+    }
+    f = function(v, key);
+  }
+  void three(const YAML::Node& n, const char* key, Vec3& out, const char* unit) {
+    if (!has(n, key)) return;
+    out = vec3(n, key, Vec3::Zero());
+    if (out.minCoeff() < 0) error(n[key], key, std::string("must not be negative (") + unit + ")");
+  }
+  void force_parameters(const YAML::Node& n, ForceSpec& f) {
+    if (!has(n, "parameters")) return;
+    const YAML::Node p = n["parameters"];
+    record(n, "parameters", p);
+    if (!p.IsMap()) {
+      error(p, "parameters", "expected a mapping name: number, got " + describe(p));
+      return;
+    }
+    for (const auto& kv : p) {
+      const auto pname = key_of(kv.first, "parameters");
+      if (!pname) continue;
+      lines->add(f.where, "parameters." + *pname, line_of(kv.first));
+      if (f.parameters.count(*pname)) error(kv.first, "parameters." + *pname, "given twice");
+      else if (f.type != ForceSpec::Type::kUser && Expression::is_reserved(*pname))
+        error(kv.first, "parameters." + *pname, quote(*pname) + " is reserved in expressions (reserved: " +
+                                                    Expression::reserved_list() + ")");
+      else if (const auto x = to_number(kv.second, "parameters." + *pname)) f.parameters[*pname] = *x;
+    }
+  }
+  void frame(const YAML::Node& n, ForceSpec& f) {
+    const std::string fr = text(n, "frame", "world");
+    if (fr == "body") f.body_frame = true;
+    else if (fr != "world" && n["frame"].IsScalar()) error(n["frame"], "frame", "expected world or body, got " + quote(fr));
+  }
+
   void force(const YAML::Node& n, Model& m) {
     static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
                                    "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
-                                   "ground", "law", "parameters"};
+                                   "ground", "law", "parameters", "frame", "torque", "coordinate", "rest",
+                                   "rest_deg", "rotational_stiffness", "rotational_damping"};
     if (!check_keys(n, "force", general)) return;
     ForceSpec f;
     f.where = where(n);
@@ -545,33 +610,67 @@ struct Loader {
       if (x) out = *x;
       if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
     };
+    auto two_points = [&] {
+      f.body1 = name(n, "body1");
+      body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
+      f.body2 = name(n, "body2");
+      body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
+    };
     if (type == "spring_damper") {
       applies(n, "a spring_damper force", general,
               {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"});
       f.type = ForceSpec::Type::kSpringDamper;
-      f.body1 = name(n, "body1");
-      f.point1 = text(n, "point1", "");
-      f.body2 = name(n, "body2");
-      f.point2 = text(n, "point2", "");
+      two_points();
       non_negative("stiffness", f.stiffness, true);
       non_negative("damping", f.damping, false);
       non_negative("free_length", f.free_length, false);
     } else if (type == "point_force") {
-      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz"});
+      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"});
       f.type = ForceSpec::Type::kPointForce;
       f.body1 = name(n, "body");
-      f.point1 = text(n, "point", "");
-      for (const char* key : {"fx", "fy", "fz"})
-        if (has(n, key)) {
-          record(n, key, n[key]);
-          (key[1] == 'x' ? f.fx : key[1] == 'y' ? f.fy : f.fz) = function(n[key], key);
-        }
+      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+      frame(n, f);
+      load_component(n, "fx", f.fx, f.expression[0]);
+      load_component(n, "fy", f.fy, f.expression[1]);
+      load_component(n, "fz", f.fz, f.expression[2]);
+      force_parameters(n, f);
+    } else if (type == "torque") {
+      applies(n, "a torque force", general, {"name", "type", "body", "axis", "frame", "torque", "parameters"});
+      f.type = ForceSpec::Type::kTorque;
+      f.body1 = name(n, "body");
+      frame(n, f);
+      f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
+      if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+      if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
+      load_component(n, "torque", f.fx, f.expression[0]);
+      force_parameters(n, f);
+    } else if (type == "joint_spring_damper") {
+      applies(n, "a joint_spring_damper force", general,
+              {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"});
+      f.type = ForceSpec::Type::kJointSpringDamper;
+      f.coordinate = name(n, "coordinate");
+      non_negative("stiffness", f.stiffness, true);
+      non_negative("damping", f.damping, false);
+      if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
+      if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
+      else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
+    } else if (type == "bushing") {
+      applies(n, "a bushing force", general, {"name", "type", "body1", "point1", "body2", "point2", "stiffness",
+                                               "damping", "rotational_stiffness", "rotational_damping"});
+      f.type = ForceSpec::Type::kBushing;
+      two_points();
+      if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
+        error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
+      three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
+      three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
+      three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
+      three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
     } else if (type == "wheel_contact") {
       applies(n, "a wheel_contact force", general,
               {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"});
       f.type = ForceSpec::Type::kWheelContact;
       f.body1 = name(n, "body");
-      f.point1 = text(n, "point", "");
+      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
       positive("stiffness", f.stiffness);
       positive("radius", f.radius);
       f.axis = vec3(n, "axis", Vec3::UnitY());
@@ -580,38 +679,26 @@ struct Loader {
     } else if (type == "user") {
       applies(n, "a user force", general, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"});
       f.type = ForceSpec::Type::kUser;
-      f.body1 = name(n, "body1");
-      f.point1 = text(n, "point1", "");
-      f.body2 = name(n, "body2");
-      f.point2 = text(n, "point2", "");
+      two_points();
       f.law = name(n, "law");
-      if (has(n, "parameters")) {
-        const YAML::Node p = n["parameters"];
-        record(n, "parameters", p);
-        if (!p.IsMap()) {
-          error(p, "parameters", "expected a mapping name: number, got " + describe(p));
-        } else {
-          for (const auto& kv : p) {
-            const auto pname = key_of(kv.first, "parameters");
-            if (!pname) continue;
-            lines->add(f.where, "parameters." + *pname, line_of(kv.first));
-            if (f.parameters.count(*pname)) error(kv.first, "parameters." + *pname, "given twice");
-            else if (const auto x = to_number(kv.second, "parameters." + *pname)) f.parameters[*pname] = *x;
-          }
-        }
-      }
+      force_parameters(n, f);
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown force type " + quote(type) + " (spring_damper, point_force, wheel_contact, user)");
+      error(n["type"], "type", "unknown force type " + quote(type) +
+                                   " (spring_damper, point_force, torque, joint_spring_damper, bushing, "
+                                   "wheel_contact, user)");
     }
     m.forces.push_back(f);
   }
 
   void sensor(const YAML::Node& n, Model& m) {
-    static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression"};
+    static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression", "wrap"};
     if (!check_keys(n, "sensor", general)) return;
     SensorSpec s;
     s.where = where(n);
     s.name = name(n);
+    if (Expression::is_reserved(s.name))
+      error(n["name"], "name", quote(s.name) + " is reserved in expressions (reserved: " + Expression::reserved_list() +
+                                   "); choose another sensor name");
     const std::string type = text(n, "type", "", true);
     using T = SensorSpec::Type;
     static const std::map<std::string, T> types = {
@@ -638,7 +725,7 @@ struct Loader {
       case T::kPosition: case T::kVelocity: case T::kAcceleration:
         applies(n, what, general, {"name", "type", "body", "point", "component"});
         s.body = name(n, "body");
-        s.point = text(n, "point", "");
+        body_point(n, "point", s.point, s.xyz, s.at_xyz);
         s.component = axis_component(n, "component");
         break;
       case T::kAxis:
@@ -649,8 +736,14 @@ struct Loader {
         s.component = axis_component(n, "component");
         break;
       case T::kCoordinate: case T::kCoordinateRate:
-        applies(n, what, general, {"name", "type", "coordinate"});
+        applies(n, what, general, {"name", "type", "coordinate", "wrap"});
         s.target = name(n, "coordinate");
+        if (has(n, "wrap")) {
+          const std::string w = text(n, "wrap", "false");
+          if (w == "true") s.wrap = true;
+          else if (w != "false" && n["wrap"].IsScalar()) error(n["wrap"], "wrap", "expected true or false, got " + quote(w));
+          if (s.type == T::kCoordinateRate) error(n["wrap"], "wrap", "does not apply to a coordinate_rate sensor (rates are not wrapped)");
+        }
         break;
       case T::kForceLength: case T::kForceValue:
         applies(n, what, general, {"name", "type", "force"});
@@ -750,16 +843,11 @@ struct Loader {
       error(at(n, "t_end"), "t_end", "the time span is empty (t_end " + format_number(s.t_end) +
                                          " must exceed t0 " + format_number(s.t0) + ")");
     if (integrates && (output_step || !has(n, "output_step"))) {
-      if (!(s.output_step > 0))
-        error(at(n, "output_step"), "output_step", "must be positive, got " + format_number(s.output_step));
-      else if (times_ok && s.t_end > s.t0 && (s.t_end - s.t0) / s.output_step > kMaxOutputRows)
-        error(at(n, "output_step"), "output_step", "too small: more than 1e8 output rows over [" +
-                                                       format_number(s.t0) + ", " + format_number(s.t_end) + "]");
+      const std::string why = output_step_range_error(s.output_step, times_ok ? s.t0 : 0, times_ok ? s.t_end : 0);
+      if (!why.empty()) error(at(n, "output_step"), "output_step", why);
     }
-    if (rtol && !(s.rtol >= 1e-14 && s.rtol <= 0.5))
-      error(n["rtol"], "rtol", "out of range [1e-14, 0.5], got " + format_number(s.rtol));
-    if (atol && !(s.atol > 0 && s.atol <= 1.0))
-      error(n["atol"], "atol", "out of range (0, 1], got " + format_number(s.atol));
+    if (rtol && !rtol_range_error(s.rtol).empty()) error(n["rtol"], "rtol", rtol_range_error(s.rtol));
+    if (atol && !atol_range_error(s.atol).empty()) error(n["atol"], "atol", atol_range_error(s.atol));
     if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
@@ -775,6 +863,12 @@ struct Loader {
   void sections(const YAML::Node& root, Model& m, bool patch) {
     if (has(root, "name")) m.name = text(root, "name", m.name);
     if (has(root, "gravity")) m.gravity = vec3(root, "gravity", m.gravity);
+    if (has(root, "ground") && check_keys(root["ground"], "ground", {"points"})) {
+      record(root, "ground", root["ground"]);
+      std::map<std::string, Vec3> points;
+      named_points(root["ground"], points);
+      for (const auto& [pname, xyz] : points) m.ground_points[pname] = xyz;  // the scene's replace the model's
+    }
     auto each = [&](const char* key, auto&& fn) {
       if (!has(root, key)) return;
       const YAML::Node list = root[key];
@@ -784,22 +878,34 @@ struct Loader {
       }
       for (const auto& item : list) fn(item);
     };
-    auto replace = [&](auto& vec, size_t before, std::set<std::string>& added_here, const char* what) {
+    // A scene item replaces the model's item of its name (found through a name -> index map, so
+    // that loading stays linear in the number of items); two of one name in this file are an error.
+    struct Names {
+      std::set<std::string> added_here;
+      std::unordered_map<std::string, size_t> index;  // first item of each name
+      bool built = false;
+    };
+    auto replace = [&](auto& vec, size_t before, Names& names, const char* what) {
       if (!patch || vec.size() == before) return;
-      auto added = vec.back();
+      if (!names.built) {
+        for (size_t k = 0; k < before; ++k) names.index.emplace(vec[k].name, k);
+        names.built = true;
+      }
+      auto added = std::move(vec.back());
       vec.pop_back();
-      if (!added.name.empty() && !added_here.insert(added.name).second) {  // keep the first
+      if (!added.name.empty() && !names.added_here.insert(added.name).second) {  // keep the first
         error_at(lines->line(added.where, "name"), "name", std::string(what) + " " + quote(added.name) + " is defined twice in this file");
         return;
       }
-      for (auto& e : vec)
-        if (e.name == added.name) {
-          e = added;
-          return;
-        }
-      vec.push_back(added);
+      const auto it = names.index.find(added.name);
+      if (it != names.index.end()) {
+        vec[it->second] = std::move(added);
+        return;
+      }
+      names.index.emplace(added.name, vec.size());
+      vec.push_back(std::move(added));
     };
-    std::set<std::string> b_names, j_names, c_names, f_names, s_names;
+    Names b_names, j_names, c_names, f_names, s_names;
     each("bodies", [&](const YAML::Node& n) { size_t b = m.bodies.size(); body(n, m); replace(m.bodies, b, b_names, "body"); });
     each("joints", [&](const YAML::Node& n) { size_t b = m.joints.size(); joint(n, m); replace(m.joints, b, j_names, "joint"); });
     each("cuts", [&](const YAML::Node& n) { size_t b = m.cuts.size(); cut(n, m); replace(m.cuts, b, c_names, "cut"); });
@@ -823,8 +929,23 @@ struct Loader {
   }
 };
 
-// Reads a file of at most kMaxFileBytes; on failure returns nullopt and says why.
+// The size limit of scene and model files in MB: MBDAE_MAX_SCENE_MB if set (a positive number),
+// else kDefaultMaxFileMB. Returns 0 (and says why) for a value that is not a positive number.
+double max_file_mb(std::string& why) {
+  const char* s = std::getenv("MBDAE_MAX_SCENE_MB");
+  if (!s) return kDefaultMaxFileMB;
+  char* end = nullptr;
+  const double mb = std::strtod(s, &end);
+  if (*s && end && *end == '\0' && mb > 0 && std::isfinite(mb)) return mb;
+  why = "MBDAE_MAX_SCENE_MB must be a positive number of megabytes, got " + quote(s);
+  return 0;
+}
+
+// Reads a file within the size limit (max_file_mb); on failure returns nullopt and says why.
 std::optional<std::string> read_text_file(const std::string& path, std::string& why) {
+  const double limit_mb = max_file_mb(why);
+  if (limit_mb <= 0) return std::nullopt;
+  const double limit_bytes = limit_mb * 1048576.0;
   std::error_code ec;
   const auto st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st)) {
@@ -844,17 +965,40 @@ std::optional<std::string> read_text_file(const std::string& path, std::string& 
   char buf[65536];
   while (in.read(buf, sizeof buf) || in.gcount() > 0) {
     text.append(buf, static_cast<size_t>(in.gcount()));
-    if (text.size() > kMaxFileBytes) {
-      why = "larger than " + std::to_string(kMaxFileBytes >> 20) + " MB";
+    if (static_cast<double>(text.size()) > limit_bytes) {
+      why = "larger than " + format_number(limit_mb) + " MB; set MBDAE_MAX_SCENE_MB to read larger files";
       return std::nullopt;
     }
   }
   return text;
 }
 
+// The line (1-based) of the '---' that starts the document whose content begins at 0-based line
+// `content` (the last '---' line up to it; the first '---' after line 1 if the document is empty).
+int second_document_line(const std::string& text, int content) {
+  std::istringstream in(text);
+  std::string line;
+  int found = 0;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (content >= 0 && k > content) break;
+    if (line.rfind("---", 0) == 0 && k > 0) {
+      found = k + 1;
+      if (content < 0) break;
+    }
+  }
+  return found;
+}
+
 std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
   try {
-    return YAML::Load(text);
+    // One document per file: a second one (after '---') would be silently ignored by YAML::Load.
+    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    if (docs.size() > 1) {
+      issues.push_back({path, second_document_line(text, docs[1].Mark().line), "",
+                        "a second YAML document ('---') is not read; a scene or model file holds one document"});
+      return std::nullopt;
+    }
+    return docs.empty() ? YAML::Node() : docs[0];
   } catch (const YAML::Exception& e) {
     issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "YAML syntax error: " + e.msg});
     return std::nullopt;
@@ -898,12 +1042,12 @@ bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, Field
   if (!complete && !src.overrides.empty()) return false;
   for (const auto& [p, v] : src.overrides)
     targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
-  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "bodies", "joints", "coordinates", "cuts",
+  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
                                           "forces", "sensors", "remove", "analysis", "output",
                                           "redundant_constraints"});
   if (mroot) {
     Loader model_loader{model_path, &issues, &lines};
-    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "bodies", "joints", "coordinates", "cuts",
+    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
                                                   "forces", "sensors"}))
       model_loader.sections(*mroot, scene.model, false);
     else

@@ -6,6 +6,7 @@
 #include "core/errors.h"
 #include "core/expression.h"
 #include "formulation/forces.h"
+#include "formulation/joint_tree.h"
 
 namespace mbdae {
 
@@ -75,16 +76,6 @@ std::string did_you_mean(const std::string& name, const std::vector<std::string>
 
 namespace {
 
-std::string chain_text(const std::vector<ElementaryJoint>& chain) {
-  std::string s;
-  for (const auto& e : chain) {
-    if (!s.empty()) s += ' ';
-    s += (e.rotation ? 'R' : 'T');
-    s += static_cast<char>('1' + e.axis);
-  }
-  return s.empty() ? "weld" : s;
-}
-
 std::string indexed(const std::string& field, size_t k) { return field + "[" + std::to_string(k) + "]"; }
 
 struct Validator {
@@ -99,9 +90,7 @@ struct Validator {
   std::map<std::string, const BodySpec*> bodies;
   std::map<std::string, const JointSpec*> joint_of_child;       // the tree joint of each body
   std::map<std::string, const JointSpec*> joint_of_coordinate;  // coordinates used by joints
-  std::set<std::string> placed = {kGround};                     // bodies with a path to ground
-  std::map<std::string, std::string> host = {{kGround, kGround}};  // rigid body each is merged into
-  std::set<std::string> merged_coordinates;                        // coordinates of merged joints
+  JointTree tree;  // order, bodies with a path to ground, merged bodies (formulation/joint_tree.h)
   std::map<std::string, const ForceSpec*> forces;
   std::map<std::string, size_t> sensor_index;  // first sensor of each name
 
@@ -134,6 +123,12 @@ struct Validator {
     return "no body named '" + name + "'" + suggestion(name, body_names());
   }
 
+  std::string ground_points_text() const {
+    std::string list = "origin";
+    for (const auto& kv : m.ground_points) list += ", " + kv.first;
+    return "its points: " + list + "; name more under ground: {points: ...}";
+  }
+
   // A body and one of its points: "" or "origin" (the body frame's origin), "com", or a named
   // point. Ground has only its origin.
   void check_point(const SourceLocation& w, const std::string& who, const std::string& body_field,
@@ -145,7 +140,9 @@ struct Validator {
     }
     if (point.empty() || point == "origin") return;
     if (body == kGround) {
-      report(w, point_field, who + "ground has no named points (only 'origin')");
+      if (!m.ground_points.count(point))
+        report(w, point_field, who + "ground has no point '" + point + "' (" + ground_points_text() +
+                                   "); expected a point name or [x, y, z]" + suggestion(point, keys(m.ground_points)));
       return;
     }
     if (point == "com") return;
@@ -156,8 +153,8 @@ struct Validator {
     std::string list;
     for (size_t k = 0; k < names.size() && k < 12; ++k) list += (k ? ", " : "") + names[k];
     if (names.size() > 12) list += ", ...";
-    report(w, point_field, who + "body '" + body + "' has no point '" + point + "' (its points: " + list + ")" +
-                               suggestion(point, names));
+    report(w, point_field, who + "body '" + body + "' has no point '" + point + "' (its points: " + list +
+                               "); expected a point name or [x, y, z]" + suggestion(point, names));
   }
 
   void check_bodies() {
@@ -174,22 +171,7 @@ struct Validator {
   }
 
   void check_chain(const JointSpec& j, const std::string& who) {
-    int switches = 0;
-    std::vector<int> rot, trans;
-    for (size_t k = 0; k < j.chain.size(); ++k) {
-      if (k > 0 && j.chain[k].rotation != j.chain[k - 1].rotation) ++switches;
-      (j.chain[k].rotation ? rot : trans).push_back(j.chain[k].axis);
-    }
-    if (switches > 1)
-      report(j.where, "chain", who + "chain " + chain_text(j.chain) +
-                                   " interleaves rotations and translations; split it with an intermediate body");
-    for (const auto* axes : {&rot, &trans}) {
-      const std::set<int> s(axes->begin(), axes->end());
-      if (s.size() != axes->size())
-        report(j.where, "chain", who + "chain " + chain_text(j.chain) + " repeats a " +
-                                     (axes == &rot ? "rotation" : "translation") +
-                                     " axis (proper Euler sequences are not supported)");
-    }
+    for (const auto& problem : chain_problems(j.chain)) report(j.where, "chain", who + problem);
   }
 
   void check_joints() {
@@ -234,7 +216,10 @@ struct Validator {
       }
       if (!j.anchor_point.empty() && !j.parent.empty()) {
         if (j.parent == kGround) {
-          report(j.where, "anchor", who + "ground has no named points; give the anchor as [x, y, z]");
+          if (!m.ground_points.count(j.anchor_point))
+            report(j.where, "anchor", who + "ground has no point '" + j.anchor_point + "' (" + ground_points_text() +
+                                          "); expected a point name or [x, y, z]" +
+                                          suggestion(j.anchor_point, keys(m.ground_points)));
         } else if (bodies.count(j.parent) && j.parent != j.child) {
           const BodySpec& p = *bodies.at(j.parent);
           if (!p.points.count(j.anchor_point)) {
@@ -261,26 +246,7 @@ struct Validator {
     // below as having none: report that body only if no such joint exists.
     bool broken_child = false;
     for (const auto& j : m.joints) broken_child = broken_child || !bodies.count(j.child);
-    std::vector<const JointSpec*> order;
-    for (bool progress = true; progress;) {
-      progress = false;
-      for (const auto& [child, j] : joint_of_child)
-        if (!placed.count(child) && placed.count(j->parent)) {
-          order.push_back(j);
-          placed.insert(child);
-          progress = true;
-        }
-    }
-    for (const JointSpec* j : order) {
-      bool merge = true;
-      for (const auto& e : j->chain) {
-        auto it = m.coordinates.find(e.coordinate);
-        if (it == m.coordinates.end() || it->second.mode != CoordinateSpec::Mode::kLocked) merge = false;
-      }
-      host[j->child] = merge ? host[j->parent] : j->child;
-      if (merge)
-        for (const auto& e : j->chain) merged_coordinates.insert(e.coordinate);
-    }
+    tree = resolve_joint_tree(m.joints, joint_of_child, m.coordinates);
     // Each body without a path to ground is cut off by a root cause: an ancestor without a
     // joint, a loop, or a joint to an unknown parent (reported already).
     struct Cause {
@@ -291,7 +257,7 @@ struct Validator {
     std::map<std::string, Cause> causes;
     std::vector<std::string> cause_order;
     for (const auto& b : m.bodies) {
-      if (placed.count(b.name) || !bodies.count(b.name) || bodies.at(b.name) != &b) continue;
+      if (tree.placed.count(b.name) || !bodies.count(b.name) || bodies.at(b.name) != &b) continue;
       std::vector<std::string> path;
       std::string cur = b.name, key;
       Cause cause;
@@ -310,7 +276,7 @@ struct Validator {
           break;
         }
         const std::string& parent = it->second->parent;
-        if (parent.empty() || !known_body(parent) || placed.count(parent)) break;  // reported elsewhere
+        if (parent.empty() || !known_body(parent) || tree.placed.count(parent)) break;  // reported elsewhere
         cur = parent;
       }
       if (key.empty()) continue;
@@ -349,8 +315,8 @@ struct Validator {
   }
 
   bool same_rigid_body(const std::string& a, const std::string& b) const {
-    auto ha = host.find(a), hb = host.find(b);
-    return ha != host.end() && hb != host.end() && ha->second == hb->second;
+    auto ha = tree.host.find(a), hb = tree.host.find(b);
+    return ha != tree.host.end() && hb != tree.host.end() && ha->second == hb->second;
   }
 
   void check_cuts() {
@@ -387,9 +353,24 @@ struct Validator {
           check_point(f.where, who, "body1", f.body1, "point1", f.point1);
           check_point(f.where, who, "body2", f.body2, "point2", f.point2);
           break;
+        case ForceSpec::Type::kBushing:
+          check_point(f.where, who, "body1", f.body1, "point1", f.point1);
+          check_point(f.where, who, "body2", f.body2, "point2", f.point2);
+          if (!f.body1.empty() && !f.body2.empty() && known_body(f.body1) && known_body(f.body2) &&
+              same_rigid_body(f.body1, f.body2))
+            report(f.where, "body2", who + "a bushing between two parts of the same rigid body");
+          break;
         case ForceSpec::Type::kPointForce:
         case ForceSpec::Type::kWheelContact:
+        case ForceSpec::Type::kTorque:
           check_point(f.where, who, "body", f.body1, "point", f.point1);
+          break;
+        case ForceSpec::Type::kJointSpringDamper:
+          if (!f.coordinate.empty() && !joint_of_coordinate.count(f.coordinate))
+            report(f.where, "coordinate", who + "no joint coordinate named '" + f.coordinate + "'" +
+                                              suggestion(f.coordinate, keys(joint_of_coordinate)));
+          else if (tree.merged_coordinates.count(f.coordinate))
+            report(f.where, "coordinate", who + "coordinate '" + f.coordinate + "' belongs to a locked joint (merged)");
           break;
       }
       if (f.type == ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&
@@ -517,7 +498,7 @@ struct Validator {
       const std::string f = indexed(field, k);
       if (!joint_of_coordinate.count(n))
         report(s.where, f, "no joint coordinate named '" + n + "'" + suggestion(n, keys(joint_of_coordinate)));
-      else if (merged_coordinates.count(n))
+      else if (tree.merged_coordinates.count(n))
         report(s.where, f, "coordinate '" + n + "' is locked (its joint is merged); it cannot be held or solved for");
       if (!seen.insert(n).second) report(s.where, f, "coordinate '" + n + "' is listed twice");
     }
@@ -575,7 +556,7 @@ struct Validator {
           }
           const auto it = m.coordinates.find(n);
           const auto mode = it == m.coordinates.end() ? CoordinateSpec::Mode::kFree : it->second.mode;
-          if (mode == CoordinateSpec::Mode::kLocked || merged_coordinates.count(n))
+          if (mode == CoordinateSpec::Mode::kLocked || tree.merged_coordinates.count(n))
             report(s.where, f, "coordinate '" + n + "' is locked: its rate is 0, not a free initial velocity");
           else if (mode == CoordinateSpec::Mode::kDriven)
             report(s.where, f, "coordinate '" + n + "' is driven: its rate at t0 is its drive's");

@@ -3,7 +3,8 @@
 // columns and analysis steps, and the joint tree (loops, bodies without a path to ground,
 // bodies welded together by a cut). Every problem is reported, each with its file, line and
 // field; build_system() repeats the essential checks as a second line of defence but stops at
-// the first.
+// the first. The chain and tree rules (which chains are refused, the tree order, which joints
+// merge bodies) are build_system's own, from formulation/joint_tree.h.
 #pragma once
 
 #include <map>

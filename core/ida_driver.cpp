@@ -2,7 +2,6 @@
 
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
-#include <sunlinsol/sunlinsol_klu.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
@@ -14,7 +13,9 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/finite_check.h"
 #include "core/klu_linear_solver.h"
+#include "core/sundials_compat.h"
 
 namespace mbdae {
 namespace {
@@ -31,18 +32,21 @@ struct UserData {
   void* mem;
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
+  int non_finite = -1;         // a component of y found not finite by weights_fn
+  double non_finite_value = 0;
 };
-
-// IDA prints its errors on stderr by default, also under `mbdae run --quiet`; keep the last one
-// for the failure message instead (warnings, error_code > 0, are dropped).
-void error_handler(int error_code, const char* module, const char* function, char* msg, void* ud) {
-  if (error_code >= 0) return;
-  auto* u = static_cast<UserData*>(ud);
-  u->last_ida_error = std::string(function) + ": " + msg;
-}
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
   auto* u = static_cast<UserData*>(ud);
+  // IDA evaluates the weights after every accepted step. A state with a NaN or an infinity gets
+  // a zero or NaN weight, which IDA does not notice (with inf in y it was seen to loop forever
+  // inside IDASolve): stop it here; the driver reports the component.
+  const int bad = first_non_finite(N_VGetArrayPointer(y), u->problem->size());
+  if (bad >= 0) {
+    u->non_finite = bad;
+    u->non_finite_value = N_VGetArrayPointer(y)[bad];
+    return -1;
+  }
   // Before the first step after an (re)initialization the step to be tried is the initial one.
   double h = 0;
   long steps = 0;
@@ -57,13 +61,13 @@ int weights_fn(N_Vector y, N_Vector w, void* ud) {
   return 0;
 }
 
-int residual_fn(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
+int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
   auto* u = static_cast<UserData*>(ud);
   return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                               N_VGetArrayPointer(r));
 }
 
-int jacobian_fn(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix jac, void* ud,
+int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix jac, void* ud,
                 N_Vector, N_Vector, N_Vector) {
   auto* u = static_cast<UserData*>(ud);
   const CscPattern& p = *u->pattern;
@@ -76,7 +80,7 @@ int jacobian_fn(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNM
                               SUNSparseMatrix_Data(jac));
 }
 
-int root_fn(realtype t, N_Vector y, N_Vector, realtype* g, void* ud) {
+int root_fn(sunrealtype t, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
   static_cast<UserData*>(ud)->problem->switches(t, N_VGetArrayPointer(y), g);
   return 0;
 }
@@ -126,8 +130,8 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   const int n = problem.size();
   const CscPattern& pattern = problem.jacobian_pattern();
 
-  SUNContext ctx;
-  SUNContext_Create(nullptr, &ctx);
+  SUNContext ctx = make_sun_context();
+  if (!ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
   N_Vector y = N_VNew_Serial(n, ctx), yp = N_VNew_Serial(n, ctx);
   N_Vector id = N_VNew_Serial(n, ctx);
   N_Vector ys = N_VNew_Serial(n, ctx), yps = N_VNew_Serial(n, ctx);
@@ -150,7 +154,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   IDAInit(mem, residual_fn, o.t0, y, yp);
   IDAWFtolerances(mem, weights_fn);
   IDASetUserData(mem, &ud);
-  IDASetErrHandlerFn(mem, error_handler, &ud);
+  keep_ida_errors(mem, ctx, &ud.last_ida_error);
   IDASetId(mem, id);
   IDASetSuppressAlg(mem, SUNTRUE);
   IDASetLinearSolver(mem, ls, jac);
@@ -182,33 +186,62 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   }
   std::sort(bps.begin(), bps.end());
 
+  // A failure other than IDA's own (those: `failure` below) ends the run; the first one is kept.
+  auto fail = [&](const std::string& status, const std::string& message, double tt) {
+    if (!stats.ok) return;
+    stats.ok = false;
+    stats.status = status;
+    stats.message = message;
+    stats.t_reached = tt;
+  };
+  // False (and the run failed) if x, a state or its derivative at tt, has a NaN or an infinity.
+  auto finite = [&](const double* x, double tt, const char* what) {
+    const int i = first_non_finite(x, n);
+    if (i < 0) return true;
+    const SolveError e = non_finite_error(what + problem.component_name(i) + " (y[" + std::to_string(i) + "])", x[i], tt);
+    fail(e.status, e.what(), tt);
+    return false;
+  };
+  // IDA's interpolant of y (k = 0) or y' (k = 1) at tt into v.
+  auto interpolate = [&](double tt, int k, N_Vector v) {
+    const int flag = IDAGetDky(mem, tt, k, v);
+    if (flag == IDA_SUCCESS) return true;
+    fail("integration_failed", "interpolating the solution at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
+    return false;
+  };
+
   // Output samples.
-  double t_next_sample = o.t0;
   long sample_index = 0;
   auto sample_time = [&](long k) {
     return o.output_step > 0 ? std::min(o.t1, o.t0 + k * o.output_step) : (k == 0 ? o.t0 : o.t1);
   };
   bool stop_requested = false;
   const bool with_derivative = problem.output_needs_derivative();
+  // One sample to the caller, after checking it: a SolveError thrown there (a sensor that is
+  // not finite) ends the run like a failure of the solver.
+  auto emit = [&](double ts, const double* yy, const double* yyp) {
+    if (!finite(yy, ts, "") || (yyp && !finite(yyp, ts, "derivative of "))) return;
+    try {
+      if (!output(ts, yy, yyp)) stop_requested = true;
+    } catch (const SolveError& e) {
+      fail(e.status, e.what(), ts);
+    }
+  };
   auto emit_until = [&](double t_reached, bool inclusive) {
-    while (!stop_requested && sample_index >= 0) {
+    while (!stop_requested && stats.ok && sample_index >= 0) {
       const double ts = sample_time(sample_index);
       if (ts > t_reached || (!inclusive && ts == t_reached)) break;
       // Always from IDA's interpolant (also at a step's own time: the y' IDA returns at a stop
       // time is not the derivative of its position interpolant).
-      IDAGetDky(mem, ts, 0, ys);
-      if (with_derivative) IDAGetDky(mem, ts, 1, yps);
-      if (!output(ts, N_VGetArrayPointer(ys), with_derivative ? N_VGetArrayPointer(yps) : nullptr))
-        stop_requested = true;
+      if (!interpolate(ts, 0, ys) || (with_derivative && !interpolate(ts, 1, yps))) break;
+      emit(ts, N_VGetArrayPointer(ys), with_derivative ? N_VGetArrayPointer(yps) : nullptr);
       if (ts >= o.t1) { sample_index = -1; break; }
       ++sample_index;
-      t_next_sample = sample_time(sample_index);
     }
   };
   // The first sample is the initial state.
-  if (!output(o.t0, y0.data(), yp0.data())) stop_requested = true;
+  emit(o.t0, y0.data(), yp0.data());
   sample_index = 1;
-  t_next_sample = sample_time(1);
 
   double t = o.t0;
   size_t next_bp = 0;
@@ -232,13 +265,23 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     std::memcpy(y_prev.data(), N_VGetArrayPointer(y), n * sizeof(double));
     std::memcpy(yp_prev.data(), N_VGetArrayPointer(yp), n * sizeof(double));
   };
-  auto failure = [&](int flag, double tt) {
+  // IDA's counters restart at every IDAReInit: add them up first (and once more at the end).
+  auto reinit = [&](double tt) {
     collect(mem, stats);
+    IDAReInit(mem, tt, y, yp);
+  };
+  auto failure = [&](int flag, double tt) {
+    IDAGetCurrentTime(mem, &tt);
+    if (ud.non_finite >= 0) {
+      const int i = ud.non_finite;
+      const SolveError e = non_finite_error(problem.component_name(i) + " (y[" + std::to_string(i) + "])",
+                                            ud.non_finite_value, tt);
+      return fail(e.status, e.what(), tt);
+    }
     std::ostringstream os;
     double h = 0;
     IDAGetCurrentStep(mem, &h);
-    IDAGetCurrentTime(mem, &tt);
-    os << "IDA failed at t = " << tt << " with step size " << h << " (" << IDAGetReturnFlagName(flag) << ")";
+    os << "IDA failed at t = " << tt << " with step size " << h << " (" << ida_flag_name(flag) << ")";
     const std::string worst = worst_components(mem, problem, ys, yps, id);
     if (!worst.empty()) os << "; largest error estimates: " << worst;
     if (!ud.last_ida_error.empty()) os << "; IDA: " << ud.last_ida_error;
@@ -247,21 +290,21 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
     stats.message = os.str();
     stats.t_reached = t;
   };
-  while (!stop_requested && t < o.t1) {
+  while (!stop_requested && stats.ok && t < o.t1) {
+    if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
     double tret = t;
     int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
     if (flag < 0) {
       failure(flag, tret);
       break;
     }
+    if (!finite(N_VGetArrayPointer(y), tret, "")) break;
     if (tret > o.t1) {
       // Past the end: the end state and the last samples are interpolated; a root beyond t1 is
       // no event of this run.
       if (flag != IDA_ROOT_RETURN) problem.after_step(tret, N_VGetArrayPointer(y));
       emit_until(o.t1, true);
-      IDAGetDky(mem, o.t1, 0, y);
-      IDAGetDky(mem, o.t1, 1, yp);
-      t = o.t1;
+      if (stats.ok && interpolate(o.t1, 0, y) && interpolate(o.t1, 1, yp)) t = o.t1;
       break;
     }
     // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
@@ -276,7 +319,6 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
       // not error-controlled at index 3. Step back to the last accepted step and integrate again
       // with the root time as stop time, so that the state at the root is a converged step.
       const double t_root = tret;
-      collect(mem, stats);
       const double h_default = ud.h_initial;
       choose_initial_step(t_prev);
       ud.h_initial = std::min(ud.h_initial, t_root - t_prev);
@@ -284,16 +326,16 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
         std::memcpy(N_VGetArrayPointer(y), y_prev.data(), n * sizeof(double));
         std::memcpy(N_VGetArrayPointer(yp), yp_prev.data(), n * sizeof(double));
         IDASetInitStep(mem, ud.h_initial);
-        IDAReInit(mem, t_prev, y, yp);
+        reinit(t_prev);
         IDARootInit(mem, 0, nullptr);
         IDASetStopTime(mem, t_root);
         t = t_prev;
       } else {
         t = t_root;  // the root is at the last step: its state is that step's
       }
-      while (t < t_root && !stop_requested) {
+      while (t < t_root && !stop_requested && stats.ok) {
         flag = IDASolve(mem, t_root, &tret, y, yp, IDA_ONE_STEP);
-        if (flag < 0) break;
+        if (flag < 0 || !finite(N_VGetArrayPointer(y), tret, "")) break;
         t = tret;
         problem.after_step(t, N_VGetArrayPointer(y));
         emit_until(t, true);
@@ -305,42 +347,38 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
         failure(flag, tret);
         break;
       }
+      if (!stats.ok) break;
       stats.event_times.push_back(t);
     } else {
       t = tret;
       problem.after_step(t, N_VGetArrayPointer(y));
       emit_until(t, true);
+      if (!stats.ok) break;
       keep_step(t);
       if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) continue;
       if (t >= o.t1) break;
       stats.breakpoint_times.push_back(t);
       ++next_bp;
     }
-    collect(mem, stats);
     while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
     problem.set_segment(t, segment_end());
     try {
       problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
     } catch (const SolveError& e) {
-      stats.ok = false;
-      stats.status = e.status;
-      stats.message = std::string("restart at t = ") + std::to_string(t) + " failed: " + e.what();
-      stats.t_reached = t;
+      fail(e.status, std::string("restart at t = ") + std::to_string(t) + " failed: " + e.what(), t);
       break;
     }
+    if (!finite(N_VGetArrayPointer(y), t, "") || !finite(N_VGetArrayPointer(yp), t, "derivative of ")) break;
     ++stats.restarts;
     choose_initial_step(t);
     IDASetInitStep(mem, ud.h_initial);
-    IDAReInit(mem, t, y, yp);
+    reinit(t);
     IDASetStopTime(mem, next_stop());
     keep_step(t);
   }
-  if (stats.ok) {
-    collect(mem, stats);
-    stats.t_reached = t;
-  }
+  collect(mem, stats);
+  if (stats.ok) stats.t_reached = t;
   stats.fresh_factorizations = klu_linear_solver_fresh_factorizations(ls);
-  (void)t_next_sample;
   std::memcpy(y0.data(), N_VGetArrayPointer(y), n * sizeof(double));
   std::memcpy(yp0.data(), N_VGetArrayPointer(yp), n * sizeof(double));
   IDAFree(&mem);

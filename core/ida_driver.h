@@ -6,6 +6,7 @@
 // At both, the problem restarts itself (new modes, consistent y') and IDA is re-initialized.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@ struct IdaOptions {
   long max_steps = 2000000;
   double nonlinear_convergence = 0.33;  // IDA's epcon
   double delta_cj = 0.01;               // relative change of cj that forces a new Newton matrix
+  const std::atomic<bool>* stop = nullptr;  // set (from a signal handler) to stop after the next step
 };
 
 struct IdaStats {

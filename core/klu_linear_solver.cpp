@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "core/klu_solver.h"
+#include "core/sundials_compat.h"
 
 namespace mbdae {
 namespace {
@@ -18,32 +19,32 @@ Content* content(SUNLinearSolver s) { return static_cast<Content*>(s->content); 
 
 SUNLinearSolver_Type get_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
 SUNLinearSolver_ID get_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
-int initialize(SUNLinearSolver) { return SUNLS_SUCCESS; }
+int initialize(SUNLinearSolver) { return kLinSolSuccess; }
 
 int setup(SUNLinearSolver s, SUNMatrix a) {
   Content* c = content(s);
   const bool ok = c->klu.factor(SUNSparseMatrix_Data(a));
   c->last_flag = ok ? 0 : 1;
-  return ok ? SUNLS_SUCCESS : SUNLS_LUFACT_FAIL;  // recoverable: IDA reduces the step
+  return ok ? kLinSolSuccess : SUNLS_LUFACT_FAIL;  // recoverable: IDA reduces the step
 }
 
-int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   Content* c = content(s);
   const sunindextype n = N_VGetLength(b);
   std::memcpy(N_VGetArrayPointer(x), N_VGetArrayPointer(b), n * sizeof(double));
   const bool ok = c->klu.solve(N_VGetArrayPointer(x));
   c->last_flag = ok ? 0 : 1;
-  return ok ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_UNREC;
+  return ok ? kLinSolSuccess : kLinSolFailUnrecoverable;
 }
 
 sunindextype last_flag(SUNLinearSolver s) { return content(s)->last_flag; }
 
 int free_solver(SUNLinearSolver s) {
-  if (!s) return SUNLS_SUCCESS;
+  if (!s) return kLinSolSuccess;
   delete content(s);
   s->content = nullptr;
   SUNLinSolFreeEmpty(s);
-  return SUNLS_SUCCESS;
+  return kLinSolSuccess;
 }
 
 }  // namespace

@@ -81,7 +81,8 @@ double TimeFunction::second_derivative(double t) const {
     }
     case Kind::kPolynomial: {
       double v = 0;
-      for (int i = static_cast<int>(ys.size()) - 1; i >= 2; --i) v = v * t + i * (i - 1) * ys[i];
+      // i (i - 1) in double: from degree 46342 on it does not fit an int.
+      for (int i = static_cast<int>(ys.size()) - 1; i >= 2; --i) v = v * t + double(i) * (i - 1) * ys[i];
       return v;
     }
   }

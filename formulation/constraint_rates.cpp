@@ -8,22 +8,11 @@
 namespace mbdae {
 namespace {
 
-// Global index of local coordinate l of a constraint between bodies bi, bj (or -1).
-inline int global_index(int bi, int bj, int l) {
-  const int b = l < 7 ? bi : bj;
-  return b < 0 ? -1 : 7 * b + (l % 7);
-}
-
-// Constraint types whose Hessian has position (r) entries (as in mechanics.cpp): for the
-// others, the rows of H_i w, and of d(v^T H_i v)/dq, vanish in the r columns.
-inline bool hessian_touches_r(const Constraint& c) {
-  return c.type == Constraint::Type::kDot2 || c.type == Constraint::Type::kDistance ||
-         (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
-}
-
-// Whether local column l of a constraint's Hessian-vector rows is in the pattern.
+// Whether local column l of a constraint's Hessian-vector rows is in the pattern: for the
+// constraints whose Hessian has no position (r) entries, the rows of H_i w, and of
+// d(v^T H_i v)/dq, vanish in the r columns.
 inline bool in_pattern(const Constraint& c, int l) {
-  return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || hessian_touches_r(c));
+  return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || constraint_hessian_touches_r(c));
 }
 
 // Hessians of a constraint's rows, one per row.
@@ -52,16 +41,6 @@ LocalState to_state(const Vec14& x) {
 
 }  // namespace
 
-void constraint_time_rates(const System& sys, const std::vector<int>& off, double t,
-                           double* phi_t) {
-  double pt[3], ptt[3];
-  for (size_t k = 0; k < sys.constraints.size(); ++k) {
-    const Constraint& c = sys.constraints[k];
-    constraint_time_derivatives(c, t, pt, ptt);
-    for (int r = 0; r < c.rows(); ++r) phi_t[off[k] + r] = pt[r];
-  }
-}
-
 void velocity_constraint_values(const System& sys, const std::vector<int>& off, const double* q,
                                 const double* v, double t, double* out) {
   Row14 rows[3];
@@ -79,8 +58,7 @@ void stabilized_acceleration_constraints(const System& sys, const std::vector<in
                                          const double* q, const double* v, const double* a,
                                          double t, double alpha, double beta, double* out) {
   Row14 rows[3];
-  Mat14 h[3];
-  double phi[3], pt[3], ptt[3];
+  double phi[3], pt[3], ptt[3], gamma[3];
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
     const LocalState s = gather(q, c.bi, c.bj);
@@ -88,10 +66,9 @@ void stabilized_acceleration_constraints(const System& sys, const std::vector<in
     constraint_value(c, s, t, phi);
     constraint_jacobian(c, s, rows);
     constraint_time_derivatives(c, t, pt, ptt);
-    row_hessians(c, s, h);
+    constraint_gamma(c, s, gather(v, c.bi, c.bj), ptt, gamma);
     for (int r = 0; r < c.rows(); ++r) {
-      const double gamma = -vl.dot(h[r] * vl) - ptt[r];
-      out[off[k] + r] = rows[r].dot(al) - gamma + 2.0 * alpha * (rows[r].dot(vl) + pt[r]) +
+      out[off[k] + r] = rows[r].dot(al) - gamma[r] + 2.0 * alpha * (rows[r].dot(vl) + pt[r]) +
                         beta * beta * phi[r];
     }
   }

@@ -19,9 +19,6 @@
 
 namespace mbdae {
 
-// Phi_t of every row (explicit time derivative; non-zero for driven coordinates only).
-void constraint_time_rates(const System& sys, const std::vector<int>& offsets, double t,
-                           double* phi_t);
 // Phi_q v + Phi_t (the velocity-level constraints).
 void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,
                                 const double* q, const double* v, double t, double* out);

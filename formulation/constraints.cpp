@@ -181,101 +181,216 @@ ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s) {
   }
 }
 
-void constraint_value(const Constraint& c, const LocalState& s, double t, double* v) {
-  switch (c.type) {
-    case Constraint::Type::kNorm: v[0] = s.pi.squaredNorm() - 1.0; return;
-    case Constraint::Type::kPoint: {
-      const Vec3 d = world_point(c.bi, s.ri, s.pi, c.si) - world_point(c.bj, s.rj, s.pj, c.sj);
-      for (int k = 0, r = 0; k < 3; ++k)
-        if (c.mask & (1 << k)) v[r++] = d[k];
-      return;
-    }
-    case Constraint::Type::kDot1:
-      v[0] = world_vector(c.bi, s.pi, c.ai).dot(world_vector(c.bj, s.pj, c.aj));
-      return;
-    case Constraint::Type::kDot2:
-      v[0] = world_vector(c.bi, s.pi, c.ai)
-                 .dot(world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si));
-      return;
-    case Constraint::Type::kDistance: {
-      const Vec3 d = world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si);
-      v[0] = d.squaredNorm() - c.distance * c.distance;
-      return;
-    }
-    case Constraint::Type::kCoordinate: {
-      const double g = coordinate_jet(c.coord, s).value - c.target.value(t);
-      v[0] = c.coord.rotation ? wrap_angle(g) : g;
-      return;
-    }
+// --- The primitives -----------------------------------------------------------------------
+// Each primitive's value, Jacobian rows, weighted Hessian sum_k w_k d2Phi_k/dq2 and velocity
+// term -qdot^T d2Phi_k/dq2 qdot (the acceleration right side gamma without -Phi_tt), side by
+// side. The velocity terms of norm, point and dot-1 are closed forms, with B(p', s) p' the
+// second time derivative of A(p) s at p'' = 0 (d/dt A s = B(p, s) p'), cheaper than v^T H v
+// (measured in docs/formulation.md, "Constraint primitives"); the others use the Hessian.
+namespace {
+
+inline Vec3 quad(int b, const Vec4& pd, const Vec3& x) {
+  return b < 0 ? Vec3::Zero() : Vec3(B_matrix(pd, x) * pd);
+}
+inline Vec3 rate(int b, const Vec4& p, const Vec4& pd, const Vec3& x) {
+  return b < 0 ? Vec3::Zero() : Vec3(B_matrix(p, x) * pd);
+}
+
+// -v^T H_k v for each row k, from the Hessian.
+void hessian_velocity_terms(const Constraint& c, const LocalState& s, const LocalState& v, double* out);
+
+// kNorm: p_i.p_i - 1 (1 row).
+void norm_value(const Constraint& c, const LocalState& s, double, double* v) { v[0] = s.pi.squaredNorm() - 1.0; }
+void norm_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  rows[0].segment<4>(kPi4) = 2.0 * s.pi.transpose();
+}
+void norm_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  h.block<4, 4>(kPi4, kPi4) += 2.0 * w[0] * Mat4::Identity();
+}
+void norm_velocity(const Constraint& c, const LocalState& s, const LocalState& v, double* g) {
+  g[0] = -2.0 * v.pi.squaredNorm();
+}
+
+// kPoint: r_i + A_i s_i - r_j - A_j s_j, the components in `mask`.
+void point_value(const Constraint& c, const LocalState& s, double, double* v) {
+  const Vec3 d = world_point(c.bi, s.ri, s.pi, c.si) - world_point(c.bj, s.rj, s.pj, c.sj);
+  for (int k = 0, r = 0; k < 3; ++k)
+    if (c.mask & (1 << k)) v[r++] = d[k];
+}
+void point_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  if (c.mask == 7) {
+    add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, rows);
+    add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, rows);
+    return;
   }
+  Row14 full[3];
+  for (auto& f : full) f.setZero();
+  add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, full);
+  add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, full);
+  for (int k = 0, r = 0; k < 3; ++k)
+    if (c.mask & (1 << k)) rows[r++] = full[k];
+}
+void point_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  Vec3 lam = Vec3::Zero();
+  for (int k = 0, r = 0; k < 3; ++k)
+    if (c.mask & (1 << k)) lam[k] = w[r++];
+  if (c.bi >= 0) h.block<4, 4>(kPi4, kPi4) += K_matrix(c.si, lam);
+  if (c.bj >= 0) h.block<4, 4>(kPj, kPj) -= K_matrix(c.sj, lam);
+}
+void point_velocity(const Constraint& c, const LocalState& s, const LocalState& v, double* g) {
+  const Vec3 h = quad(c.bi, v.pi, c.si) - quad(c.bj, v.pj, c.sj);
+  for (int k = 0, r = 0; k < 3; ++k)
+    if (c.mask & (1 << k)) g[r++] = -h[k];
+}
+
+// kDot1: (A_i a_i).(A_j a_j).
+void dot1_value(const Constraint& c, const LocalState& s, double, double* v) {
+  v[0] = world_vector(c.bi, s.pi, c.ai).dot(world_vector(c.bj, s.pj, c.aj));
+}
+void dot1_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  rows[0] = dot1_jet(c.bi, c.bj, s, c.ai, c.aj).grad;
+}
+void dot1_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  h += w[0] * dot1_jet(c.bi, c.bj, s, c.ai, c.aj).hess;
+}
+void dot1_velocity(const Constraint& c, const LocalState& s, const LocalState& v, double* g) {
+  const Vec3 u = world_vector(c.bi, s.pi, c.ai), w = world_vector(c.bj, s.pj, c.aj);
+  const double h = quad(c.bi, v.pi, c.ai).dot(w) + u.dot(quad(c.bj, v.pj, c.aj)) +
+                   2.0 * rate(c.bi, s.pi, v.pi, c.ai).dot(rate(c.bj, s.pj, v.pj, c.aj));
+  g[0] = -h;
+}
+
+// kDot2: (A_i a_i).(r_j + A_j s_j - r_i - A_i s_i).
+void dot2_value(const Constraint& c, const LocalState& s, double, double* v) {
+  v[0] = world_vector(c.bi, s.pi, c.ai)
+             .dot(world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si));
+}
+void dot2_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  rows[0] = dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).grad;
+}
+void dot2_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  h += w[0] * dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).hess;
+}
+
+// kDistance: |d|^2 - D^2, d = r_j + A_j s_j - r_i - A_i s_i.
+Vec3 distance_vector(const Constraint& c, const LocalState& s) {
+  return world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si);
+}
+// Jacobian of d (3 rows).
+void distance_vector_jacobian(const Constraint& c, const LocalState& s, Row14* dd) {
+  for (int k = 0; k < 3; ++k) dd[k].setZero();
+  add_point_jacobian(c.bj, s.pj, c.sj, 1.0, kRj, kPj, dd);
+  add_point_jacobian(c.bi, s.pi, c.si, -1.0, kRi, kPi4, dd);
+}
+void distance_value(const Constraint& c, const LocalState& s, double, double* v) {
+  v[0] = distance_vector(c, s).squaredNorm() - c.distance * c.distance;
+}
+void distance_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  const Vec3 d = distance_vector(c, s);
+  Row14 dd[3];
+  distance_vector_jacobian(c, s, dd);
+  rows[0] = 2.0 * (d[0] * dd[0] + d[1] * dd[1] + d[2] * dd[2]);
+}
+void distance_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  // Hessian = 2 (Jd^T Jd + sum_k d_k d2(d_k)).
+  const Vec3 d = distance_vector(c, s);
+  Row14 dd[3];
+  distance_vector_jacobian(c, s, dd);
+  Mat14 hh = Mat14::Zero();
+  for (int k = 0; k < 3; ++k) hh += dd[k].transpose() * dd[k];
+  if (c.bj >= 0) hh.block<4, 4>(kPj, kPj) += K_matrix(c.sj, d);
+  if (c.bi >= 0) hh.block<4, 4>(kPi4, kPi4) -= K_matrix(c.si, d);
+  h += 2.0 * w[0] * hh;
+}
+
+// kCoordinate: g(q) - f(t), wrapped into (-pi, pi] for a rotation.
+void coordinate_value(const Constraint& c, const LocalState& s, double t, double* v) {
+  const double g = coordinate_jet(c.coord, s).value - c.target.value(t);
+  v[0] = c.coord.rotation ? wrap_angle(g) : g;
+}
+void coordinate_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  rows[0] = coordinate_jet(c.coord, s).grad;
+}
+void coordinate_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  h += w[0] * coordinate_jet(c.coord, s).hess;
+}
+
+struct Primitive {
+  void (*value)(const Constraint&, const LocalState&, double t, double* v);
+  void (*jacobian)(const Constraint&, const LocalState&, Row14* rows);  // rows zeroed before
+  void (*hessian)(const Constraint&, const LocalState&, const double* w, Mat14& h);
+  void (*velocity)(const Constraint&, const LocalState&, const LocalState& v, double* g);
+  bool hessian_touches_r;  // whether d2Phi/dq2 has entries in the r rows and columns
+};
+
+// In the order of Constraint::Type.
+const Primitive kPrimitives[] = {
+    {norm_value, norm_jacobian, norm_hessian, norm_velocity, false},
+    {point_value, point_jacobian, point_hessian, point_velocity, false},
+    {dot1_value, dot1_jacobian, dot1_hessian, dot1_velocity, false},
+    {dot2_value, dot2_jacobian, dot2_hessian, hessian_velocity_terms, true},
+    {distance_value, distance_jacobian, distance_hessian, hessian_velocity_terms, true},
+    {coordinate_value, coordinate_jacobian, coordinate_hessian, hessian_velocity_terms, false},
+};
+static_assert(sizeof(kPrimitives) / sizeof(kPrimitives[0]) == 6, "one entry per Constraint::Type");
+
+const Primitive& primitive(const Constraint& c) { return kPrimitives[static_cast<int>(c.type)]; }
+
+void hessian_velocity_terms(const Constraint& c, const LocalState& s, const LocalState& sv, double* out) {
+  Vec14 v = Vec14::Zero();
+  if (c.bi >= 0) v.head<7>() << sv.ri, sv.pi;
+  if (c.bj >= 0) v.tail<7>() << sv.rj, sv.pj;
+  for (int r = 0; r < c.rows(); ++r) {
+    double w[3] = {0, 0, 0};
+    w[r] = 1.0;
+    Mat14 h = Mat14::Zero();
+    primitive(c).hessian(c, s, w, h);
+    out[r] = -v.dot(h * v);
+  }
+}
+
+}  // namespace
+
+void constraint_value(const Constraint& c, const LocalState& s, double t, double* v) {
+  primitive(c).value(c, s, t, v);
 }
 
 void constraint_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
   for (int k = 0; k < c.rows(); ++k) rows[k].setZero();
-  switch (c.type) {
-    case Constraint::Type::kNorm: rows[0].segment<4>(kPi4) = 2.0 * s.pi.transpose(); return;
-    case Constraint::Type::kPoint: {
-      if (c.mask == 7) {
-        add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, rows);
-        add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, rows);
-        return;
-      }
-      Row14 full[3];
-      for (auto& f : full) f.setZero();
-      add_point_jacobian(c.bi, s.pi, c.si, 1.0, kRi, kPi4, full);
-      add_point_jacobian(c.bj, s.pj, c.sj, -1.0, kRj, kPj, full);
-      for (int k = 0, r = 0; k < 3; ++k)
-        if (c.mask & (1 << k)) rows[r++] = full[k];
-      return;
-    }
-    case Constraint::Type::kDot1: rows[0] = dot1_jet(c.bi, c.bj, s, c.ai, c.aj).grad; return;
-    case Constraint::Type::kDot2:
-      rows[0] = dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).grad;
-      return;
-    case Constraint::Type::kDistance: {
-      const Vec3 d = world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si);
-      Row14 dd[3];
-      for (auto& r : dd) r.setZero();
-      add_point_jacobian(c.bj, s.pj, c.sj, 1.0, kRj, kPj, dd);
-      add_point_jacobian(c.bi, s.pi, c.si, -1.0, kRi, kPi4, dd);
-      rows[0] = 2.0 * (d[0] * dd[0] + d[1] * dd[1] + d[2] * dd[2]);
-      return;
-    }
-    case Constraint::Type::kCoordinate: rows[0] = coordinate_jet(c.coord, s).grad; return;
-  }
+  primitive(c).jacobian(c, s, rows);
 }
 
 void constraint_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
-  switch (c.type) {
-    case Constraint::Type::kNorm: h.block<4, 4>(kPi4, kPi4) += 2.0 * w[0] * Mat4::Identity(); return;
-    case Constraint::Type::kPoint: {
-      Vec3 lam = Vec3::Zero();
-      for (int k = 0, r = 0; k < 3; ++k)
-        if (c.mask & (1 << k)) lam[k] = w[r++];
-      if (c.bi >= 0) h.block<4, 4>(kPi4, kPi4) += K_matrix(c.si, lam);
-      if (c.bj >= 0) h.block<4, 4>(kPj, kPj) -= K_matrix(c.sj, lam);
-      return;
-    }
-    case Constraint::Type::kDot1: h += w[0] * dot1_jet(c.bi, c.bj, s, c.ai, c.aj).hess; return;
-    case Constraint::Type::kDot2:
-      h += w[0] * dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).hess;
-      return;
-    case Constraint::Type::kDistance: {
-      // Phi = d.d - D^2: Hessian = 2 (Jd^T Jd + sum_k d_k d2(d_k)).
-      const Vec3 d = world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si);
-      Row14 dd[3];
-      for (auto& r : dd) r.setZero();
-      add_point_jacobian(c.bj, s.pj, c.sj, 1.0, kRj, kPj, dd);
-      add_point_jacobian(c.bi, s.pi, c.si, -1.0, kRi, kPi4, dd);
-      Mat14 hh = Mat14::Zero();
-      for (int k = 0; k < 3; ++k) hh += dd[k].transpose() * dd[k];
-      if (c.bj >= 0) hh.block<4, 4>(kPj, kPj) += K_matrix(c.sj, d);
-      if (c.bi >= 0) hh.block<4, 4>(kPi4, kPi4) -= K_matrix(c.si, d);
-      h += 2.0 * w[0] * hh;
-      return;
-    }
-    case Constraint::Type::kCoordinate: h += w[0] * coordinate_jet(c.coord, s).hess; return;
+  primitive(c).hessian(c, s, w, h);
+}
+
+void constraint_gamma(const Constraint& c, const LocalState& s, const LocalState& v, const double* phi_tt,
+                      double* gamma) {
+  primitive(c).velocity(c, s, v, gamma);
+  for (int r = 0; r < c.rows(); ++r) gamma[r] -= phi_tt[r];
+}
+
+bool constraint_hessian_touches_r(const Constraint& c) {
+  return primitive(c).hessian_touches_r || (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
+}
+
+std::string row_label(const Constraint& c, int row) {
+  if (c.type != Constraint::Type::kPoint) return c.label;
+  for (int comp = 0, r = 0; comp < 3; ++comp)
+    if (c.mask & (1 << comp) && r++ == row) return c.label + " [" + "xyz"[comp] + "]";
+  return c.label;
+}
+
+std::string constraint_group(const Constraint& c) {
+  switch (c.owner) {
+    case Constraint::Owner::kNorm: return "body " + c.owner_name;
+    case Constraint::Owner::kJoint: return "joint " + c.owner_name;
+    case Constraint::Owner::kCut: return "cut " + c.owner_name;
+    case Constraint::Owner::kDrive: return "drive " + c.owner_name;
+    case Constraint::Owner::kLock: return "lock " + c.owner_name;
+    case Constraint::Owner::kHold: return "hold " + c.owner_name;
   }
+  return c.owner_name;
 }
 
 void constraint_time_derivatives(const Constraint& c, double t, double* phi_t, double* phi_tt) {

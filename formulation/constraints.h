@@ -6,7 +6,8 @@
 // Jacobian) and its Hessian (needed for the exact Newton matrix, sum_k lambda_k d2Phi_k/dq2,
 // and for the acceleration-level right side gamma = -qdot^T d2Phi/dq2 qdot - Phi_tt).
 //
-// Primitive equations (Haug, Computer-Aided Kinematics and Dynamics, ch. 9 and 11):
+// Primitive equations (Haug, Computer-Aided Kinematics and Dynamics, ch. 9 and 11), each with its
+// value, Jacobian, Hessian and acceleration right side in one table in constraints.cpp:
 //   kNorm   p_i.p_i - 1 = 0
 //   kPoint  r_i + A_i s_i - r_j - A_j s_j = 0                       (3 rows)
 //   kDot1   (A_i a_i).(A_j a_j) = 0                                 (perpendicular axes)
@@ -47,17 +48,22 @@ struct CoordinateFunction {
 
 struct Constraint {
   enum class Type { kNorm, kPoint, kDot1, kDot2, kDistance, kCoordinate };
+  // What the equation belongs to: a body's Euler-parameter norm, a tree joint, a loop cut, a
+  // driven, locked or held (assembly, equilibrium) joint coordinate.
+  enum class Owner { kNorm, kJoint, kCut, kDrive, kLock, kHold };
   Type type = Type::kPoint;
+  Owner owner = Owner::kJoint;
+  std::string owner_name;  // the body, joint, cut or coordinate
   int bi = -1, bj = -1;  // body indices, -1 = ground (its points are world points)
   Vec3 si = Vec3::Zero(), sj = Vec3::Zero();
   Vec3 ai = Vec3::Zero(), aj = Vec3::Zero();
   double distance = 0;
   CoordinateFunction coord;  // kCoordinate
   TimeFunction target;       // kCoordinate: f(t)
-  std::string label;         // e.g. "joint rod2: axis x _|_ z"
+  std::string label;         // for messages, e.g. "joint rod2 (R1): parent y _|_ child x"
   int mask = 7;              // kPoint: active components (bit k = world axis k); rows compacted
 
-  int rows() const { return type == Type::kPoint ? __builtin_popcount(mask) : 1; }
+  int rows() const { return type == Type::kPoint ? (mask & 1) + (mask >> 1 & 1) + (mask >> 2 & 1) : 1; }
 };
 
 // Local coordinates of a constraint's two bodies, gathered from the global vector q.
@@ -76,6 +82,25 @@ void constraint_jacobian(const Constraint& c, const LocalState& s, Row14* rows);
 void constraint_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h);
 // Explicit time derivatives dPhi/dt and d2Phi/dt2 of each row (non-zero for driven rows).
 void constraint_time_derivatives(const Constraint& c, double t, double* phi_t, double* phi_tt);
+// The acceleration right side of each row, gamma = -v^T d2Phi/dq2 v - Phi_tt, for the
+// velocities v gathered like the coordinates s (gather(v, bi, bj)) and the rows' Phi_tt.
+void constraint_gamma(const Constraint& c, const LocalState& s, const LocalState& v,
+                      const double* phi_tt, double* gamma);
+// Whether the Hessian has entries in the position (r) rows and columns (dot-2, distance,
+// translation coordinates); the others depend on r linearly or not at all.
+bool constraint_hessian_touches_r(const Constraint& c);
+// Global index of local coordinate l (0..13) of a constraint between bodies bi, bj; -1 for ground.
+inline int global_index(int bi, int bj, int l) {
+  const int b = l < 7 ? bi : bj;
+  return b < 0 ? -1 : 7 * b + (l % 7);
+}
+
+// "joint rod2 (R1): origin at anchor [y]": a constraint's label, with the world component of a
+// point constraint's row `row` (rows counted among the active components).
+std::string row_label(const Constraint& c, int row);
+// "joint rod2", "cut ball2", "drive q4", "lock q1", "hold q1", "body rod3": what the constraint
+// belongs to.
+std::string constraint_group(const Constraint& c);
 
 // Value, gradient and Hessian of a joint coordinate function (for sensors and drivers).
 struct ScalarJet {

@@ -125,7 +125,161 @@ Contact contact(const Force& f, const LocalState& x, double t, bool with_gradien
   }
   return c;
 }
+
+// Component k of a point force or torque: its expression's value if it has one, else fx/fy/fz(t).
+double component(const Force& f, int k, double t, const LoadInput* in) {
+  if (!f.expression[k].empty()) return in ? in->value[k] : 0.0;
+  return (k == 0 ? f.fx : k == 1 ? f.fy : f.fz).value(t);
+}
+
+// The constant matrix M(a) of the torque map Q_p = 2 T M(a) p (see forces.h).
+Mat4 torque_map(const Vec3& a, bool body_axes) {
+  Mat4 m;
+  m(0, 0) = 0;
+  m.block<1, 3>(0, 1) = -a.transpose();
+  m.block<3, 1>(1, 0) = a;
+  m.block<3, 3>(1, 1) = body_axes ? Mat3(-skew(a)) : skew(a);
+  return m;
+}
+
+void torque_eval(const Force& f, const LocalState& x, double t, const LoadInput* in, Vec14& q,
+                 Mat14* dqx, Mat14x3* dqin) {
+  if (f.bi < 0) return;
+  const double magnitude = component(f, 0, t, in);
+  const Mat4 m = torque_map(f.axis, f.body_frame);
+  q.segment<4>(kPi4) += 2.0 * magnitude * (m * x.pi);
+  if (dqx) dqx->block<4, 4>(kPi4, kPi4) += 2.0 * magnitude * m;
+  if (dqin) dqin->block<4, 1>(kPi4, 0) += 2.0 * (m * x.pi);
+}
+
+// Point force in world axes, or in body axes (follower force: f = A(p) F).
+void point_force_eval(const Force& f, const LocalState& x, double t, const LoadInput* in,
+                      Vec14& q, Mat14* dqx, Mat14x3* dqin) {
+  if (f.bi < 0) return;
+  const Vec3 given(component(f, 0, t, in), component(f, 1, t, in), component(f, 2, t, in));
+  Mat3 to_world = Mat3::Identity();  // d(world force)/d(components)
+  if (f.body_frame) to_world = rotation(x.pi) * f.frame_i;
+  const Vec3 force = to_world * given;
+  apply_point_force(f.bi, x.pi, f.si, force, false, q, dqx);
+  if (dqx && f.body_frame) {
+    const Mat34 dforce = B_matrix(x.pi, f.frame_i * given);
+    dqx->block<3, 4>(kRi, kPi4) += dforce;
+    dqx->block<4, 4>(kPi4, kPi4) += B_matrix(x.pi, f.si).transpose() * dforce;
+  }
+  if (dqin) {
+    dqin->block<3, 3>(kRi, 0) += to_world;
+    dqin->block<4, 3>(kPi4, 0) += B_matrix(x.pi, f.si).transpose() * to_world;
+  }
+}
+
+void joint_spring_eval(const Force& f, const LocalState& x, const LocalState& v, Vec14& q,
+                       Mat14* dqx, Mat14* dqv) {
+  const ScalarJet jet = coordinate_jet(f.coordinate, x);
+  const Vec14 vl = local_vector(v);
+  const double stretch =
+      f.coordinate.rotation ? wrap_angle(jet.value - f.free_length) : jet.value - f.free_length;
+  const double rate = jet.grad.dot(vl);
+  const double tau = f.stiffness * stretch + f.damping * rate;
+  q.noalias() -= tau * jet.grad.transpose();
+  if (!dqx) return;
+  const Row14 drate_dx = (jet.hess * vl).transpose();
+  dqx->noalias() -= jet.grad.transpose() * (f.stiffness * jet.grad + f.damping * drate_dx);
+  *dqx -= tau * jet.hess;
+  dqv->noalias() -= f.damping * jet.grad.transpose() * jet.grad;
+}
+
+// Quaternion products as matrices: a (x) b = left(a) b = right(b) a.
+Mat4 quat_left(const Vec4& a) {
+  Mat4 m;
+  m << a[0], -a[1], -a[2], -a[3], a[1], a[0], -a[3], a[2], a[2], a[3], a[0], -a[1], a[3], -a[2],
+      a[1], a[0];
+  return m;
+}
+Mat4 quat_right(const Vec4& b) {
+  Mat4 m;
+  m << b[0], -b[1], -b[2], -b[3], b[1], b[0], b[3], -b[2], b[2], -b[3], b[0], b[1], b[3], b[2],
+      -b[1], b[0];
+  return m;
+}
+Vec4 conj(const Vec4& p) { return Vec4(p[0], -p[1], -p[2], -p[3]); }
+
+// Bushing coordinates y = (d, theta) and their Jacobian J = dy/dx (6 x 14), see forces.h.
+void bushing_coordinates(const Force& f, const LocalState& x, Eigen::Matrix<double, 6, 1>& y,
+                         Eigen::Matrix<double, 6, 14>& jac) {
+  const Vec4 c1 = euler_parameters_from_rotation(f.frame_i);
+  const Vec4 c2 = euler_parameters_from_rotation(f.frame_j);
+  const Vec4 p1 = f.bi < 0 ? Vec4(1, 0, 0, 0) : Vec4(x.pi), p2 = f.bj < 0 ? Vec4(1, 0, 0, 0) : Vec4(x.pj);
+  const Vec3 delta = point(f.bj, x.rj, x.pj, f.sj) - point(f.bi, x.ri, x.pi, f.si);
+  const Mat3 c1t = f.frame_i.transpose();
+  const Mat3 a1t = rotation(p1).transpose();
+  y.head<3>() = c1t * (a1t * delta);
+  jac = Eigen::Matrix<double, 6, 14>::Zero();
+  const Eigen::Matrix<double, 3, 14> ddelta =
+      point_jacobian(f.bj, p2, f.sj, true) - point_jacobian(f.bi, p1, f.si, false);
+  jac.topRows<3>() = c1t * a1t * ddelta;
+  const Mat4 flip = Vec4(1, -1, -1, -1).asDiagonal();
+  if (f.bi >= 0) jac.block<3, 4>(0, kPi4) += c1t * B_matrix(conj(p1), delta) * flip;
+  // w = conj(c1) conj(p1) p2 c2.
+  const Vec4 g2 = quat_left(p2) * c2;
+  const Vec4 w = quat_left(conj(c1)) * (quat_left(conj(p1)) * g2);
+  const double sign = w[0] < 0 ? -1.0 : 1.0;
+  y.tail<3>() = 2.0 * sign * w.tail<3>();
+  if (f.bi >= 0)
+    jac.block<3, 4>(3, kPi4) = 2.0 * sign * (quat_left(conj(c1)) * quat_right(g2) * flip).bottomRows<3>();
+  if (f.bj >= 0)
+    jac.block<3, 4>(3, kPj) =
+        2.0 * sign * (quat_left(conj(c1)) * quat_left(conj(p1)) * quat_right(c2)).bottomRows<3>();
+}
+
+Vec14 bushing_force(const Force& f, const LocalState& x, const Vec14& vl) {
+  Eigen::Matrix<double, 6, 1> y, k, c;
+  Eigen::Matrix<double, 6, 14> jac;
+  bushing_coordinates(f, x, y, jac);
+  k << f.kt, f.kr;
+  c << f.ct, f.cr;
+  const Eigen::Matrix<double, 6, 1> gen = k.cwiseProduct(y) + c.cwiseProduct(jac * vl);
+  return -jac.transpose() * gen;
+}
+
+LocalState shifted(const LocalState& x, int l, double h) {
+  Vec14 y = local_vector(x);
+  y[l] += h;
+  return local_state(y);
+}
+
+void bushing_eval(const Force& f, const LocalState& x, const LocalState& v, Vec14& q, Mat14* dqx,
+                  Mat14* dqv) {
+  const Vec14 vl = local_vector(v);
+  q += bushing_force(f, x, vl);
+  if (!dqx) return;
+  Eigen::Matrix<double, 6, 1> y, c;
+  Eigen::Matrix<double, 6, 14> jac;
+  bushing_coordinates(f, x, y, jac);
+  c << f.ct, f.cr;
+  *dqv -= jac.transpose() * c.asDiagonal() * jac;
+  const Vec14 xl = local_vector(x);
+  for (int l = 0; l < 14; ++l) {
+    if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
+    const double h = 1e-6 * std::max(1.0, std::fabs(xl[l]));
+    dqx->col(l) += (bushing_force(f, shifted(x, l, h), vl) - bushing_force(f, shifted(x, l, -h), vl)) / (2 * h);
+  }
+}
 }  // namespace
+
+Vec14 local_vector(const LocalState& s) {
+  Vec14 y;
+  y << s.ri, s.pi, s.rj, s.pj;
+  return y;
+}
+
+LocalState local_state(const Vec14& y) {
+  LocalState s;
+  s.ri = y.segment<3>(0);
+  s.pi = y.segment<4>(3);
+  s.rj = y.segment<3>(7);
+  s.pj = y.segment<4>(10);
+  return s;
+}
 
 const UserForceLaw* find_force_law(const std::string& name) {
   static const std::map<std::string, UserForceLaw> laws = builtin_laws();  // thread-safe initialization
@@ -134,8 +288,12 @@ const UserForceLaw* find_force_law(const std::string& name) {
 }
 
 void force_eval(const Force& f, const LocalState& x, const LocalState& v, double t,
-                bool in_contact, Vec14& q, Mat14* dqx, Mat14* dqv) {
+                bool in_contact, Vec14& q, Mat14* dqx, Mat14* dqv, const LoadInput* in,
+                Mat14x3* dqin) {
   switch (f.type) {
+    case ForceSpec::Type::kTorque: torque_eval(f, x, t, in, q, dqx, dqin); return;
+    case ForceSpec::Type::kJointSpringDamper: joint_spring_eval(f, x, v, q, dqx, dqv); return;
+    case ForceSpec::Type::kBushing: bushing_eval(f, x, v, q, dqx, dqv); return;
     case ForceSpec::Type::kSpringDamper:
     case ForceSpec::Type::kUser: {
       const TwoPoint tp = two_point(f, x, v);
@@ -154,11 +312,7 @@ void force_eval(const Force& f, const LocalState& x, const LocalState& v, double
       }
       return;
     }
-    case ForceSpec::Type::kPointForce: {
-      const Vec3 force(f.fx.value(t), f.fy.value(t), f.fz.value(t));
-      apply_point_force(f.bi, x.pi, f.si, force, false, q, dqx);
-      return;
-    }
+    case ForceSpec::Type::kPointForce: point_force_eval(f, x, t, in, q, dqx, dqin); return;
     case ForceSpec::Type::kWheelContact: {
       if (!in_contact) return;
       const Contact c = contact(f, x, t, dqx != nullptr);
@@ -174,6 +328,11 @@ void force_eval(const Force& f, const LocalState& x, const LocalState& v, double
 }
 
 double* force_parameter(Force& f, const std::string& p) {
+  for (size_t k = 0; k < f.parameter_names.size(); ++k)
+    if (f.parameter_names[k] == p) return &f.parameters[k];
+  if (f.type == ForceSpec::Type::kBushing || f.type == ForceSpec::Type::kTorque ||
+      f.type == ForceSpec::Type::kPointForce)
+    return nullptr;
   if (p == "free_length") return &f.free_length;
   if (p == "stiffness") return &f.stiffness;
   if (p == "damping") return &f.damping;
@@ -203,23 +362,76 @@ double force_switch_value(const Force& f, const LocalState& x, double t) {
 }
 
 double force_length(const Force& f, const LocalState& x) {
-  if (f.type == ForceSpec::Type::kWheelContact) return contact(f, x, 0.0, false).e;
-  return (point(f.bj, x.rj, x.pj, f.sj) - point(f.bi, x.ri, x.pi, f.si)).norm();
+  switch (f.type) {
+    case ForceSpec::Type::kWheelContact: return contact(f, x, 0.0, false).e;
+    case ForceSpec::Type::kJointSpringDamper: return coordinate_jet(f.coordinate, x).value;
+    case ForceSpec::Type::kTorque: return 0.0;
+    case ForceSpec::Type::kBushing: {
+      Eigen::Matrix<double, 6, 1> y;
+      Eigen::Matrix<double, 6, 14> jac;
+      bushing_coordinates(f, x, y, jac);
+      return y.head<3>().norm();
+    }
+    default: return (point(f.bj, x.rj, x.pj, f.sj) - point(f.bi, x.ri, x.pi, f.si)).norm();
+  }
 }
 
 double force_magnitude(const Force& f, const LocalState& x, const LocalState& v, double t,
-                       bool in_contact) {
+                       bool in_contact, const LoadInput* in) {
   switch (f.type) {
     case ForceSpec::Type::kWheelContact:
       return in_contact ? f.stiffness * contact(f, x, t, false).e : 0.0;
     case ForceSpec::Type::kPointForce:
-      return Vec3(f.fx.value(t), f.fy.value(t), f.fz.value(t)).norm();
+      return Vec3(component(f, 0, t, in), component(f, 1, t, in), component(f, 2, t, in)).norm();
+    case ForceSpec::Type::kTorque: return component(f, 0, t, in);
+    case ForceSpec::Type::kJointSpringDamper: {
+      // The generalized force on the coordinate, -tau (a torque for a rotation).
+      Vec14 q = Vec14::Zero();
+      joint_spring_eval(f, x, v, q, nullptr, nullptr);
+      const ScalarJet jet = coordinate_jet(f.coordinate, x);
+      return q.dot(jet.grad.transpose()) / jet.grad.squaredNorm();
+    }
+    case ForceSpec::Type::kBushing: {
+      // Magnitude of the force on body 1, |K_t d + C_t d'| (frame-1 axes).
+      Eigen::Matrix<double, 6, 1> y;
+      Eigen::Matrix<double, 6, 14> jac;
+      bushing_coordinates(f, x, y, jac);
+      const Vec14 vl = local_vector(v);
+      return (f.kt.cwiseProduct(y.head<3>()) + f.ct.cwiseProduct((jac * vl).head<3>())).norm();
+    }
     default: {
       const TwoPoint tp = two_point(f, x, v);
       Vec3 force;
       two_point_law(f, tp, t, force, nullptr, nullptr);
       return force.dot(tp.d.normalized());
     }
+  }
+}
+
+double force_potential(const Force& f, const LocalState& x, double t, bool in_contact) {
+  switch (f.type) {
+    case ForceSpec::Type::kSpringDamper: {
+      const double stretch = force_length(f, x) - f.free_length;
+      return 0.5 * f.stiffness * stretch * stretch;
+    }
+    case ForceSpec::Type::kWheelContact: {
+      if (!in_contact) return 0.0;
+      const double e = force_switch_value(f, x, t);
+      return 0.5 * f.stiffness * e * e;
+    }
+    case ForceSpec::Type::kJointSpringDamper: {
+      const double g = coordinate_jet(f.coordinate, x).value - f.free_length;
+      const double stretch = f.coordinate.rotation ? wrap_angle(g) : g;
+      return 0.5 * f.stiffness * stretch * stretch;
+    }
+    case ForceSpec::Type::kBushing: {
+      Eigen::Matrix<double, 6, 1> y, k;
+      Eigen::Matrix<double, 6, 14> jac;
+      bushing_coordinates(f, x, y, jac);
+      k << f.kt, f.kr;
+      return 0.5 * y.dot(k.cwiseProduct(y));
+    }
+    default: return 0.0;
   }
 }
 

@@ -1,22 +1,12 @@
 #include "formulation/mechanics.h"
 
+#include "formulation/sensors.h"
+
 #include <cmath>
 #include <cstdlib>
 
 namespace mbdae {
 namespace {
-
-// Global index of local coordinate l of a constraint between bodies bi, bj (or -1).
-inline int global_index(int bi, int bj, int l) {
-  const int b = l < 7 ? bi : bj;
-  return b < 0 ? -1 : 7 * b + (l % 7);
-}
-
-// Constraint types whose Hessian has position (r) entries.
-inline bool hessian_touches_r(const Constraint& c) {
-  return c.type == Constraint::Type::kDot2 || c.type == Constraint::Type::kDistance ||
-         (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
-}
 
 inline Vec4 p_of(const double* q, int b) { return Eigen::Map<const Vec4>(q + 7 * b + 3); }
 
@@ -79,7 +69,9 @@ void generalized_forces(const System& sys, const std::vector<char>& modes, const
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
-    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr);
+    LoadInput in;
+    if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr, &in);
     for (int l = 0; l < 14; ++l) {
       const int g = global_index(f.bi, f.bj, l);
       if (g >= 0) out[g] += ql[l];
@@ -103,44 +95,8 @@ void constraint_rates(const System& sys, const std::vector<int>& off, const doub
     constraint_time_derivatives(c, t, pt, ptt);
     if (phi_t)
       for (int r = 0; r < c.rows(); ++r) phi_t[off[k] + r] = pt[r];
-    if (!gamma) continue;
-    // gamma = -qdot^T Phi_qq qdot - Phi_tt. Closed forms for the common primitives, using
-    // B(p', s) p' = d2(A s)/dt2 at p'' = 0; the Hessian for the others.
-    const LocalState s = gather(q, c.bi, c.bj), sv = gather(v, c.bi, c.bj);
-    auto quad = [](int b, const Vec4& pd, const Vec3& x) -> Vec3 {
-      return b < 0 ? Vec3::Zero() : Vec3(B_matrix(pd, x) * pd);
-    };
-    auto rate = [](int b, const Vec4& p, const Vec4& pd, const Vec3& x) -> Vec3 {
-      return b < 0 ? Vec3::Zero() : Vec3(B_matrix(p, x) * pd);
-    };
-    auto world = [](int b, const Vec4& p, const Vec3& x) -> Vec3 { return b < 0 ? x : rotate(p, x); };
-    double* g = gamma + off[k];
-    switch (c.type) {
-      case Constraint::Type::kNorm: g[0] = -2.0 * sv.pi.squaredNorm() - ptt[0]; break;
-      case Constraint::Type::kPoint: {
-        const Vec3 h = quad(c.bi, sv.pi, c.si) - quad(c.bj, sv.pj, c.sj);
-        for (int k = 0, r = 0; k < 3; ++k)
-          if (c.mask & (1 << k)) { g[r] = -h[k] - ptt[r]; ++r; }
-        break;
-      }
-      case Constraint::Type::kDot1: {
-        const Vec3 u = world(c.bi, s.pi, c.ai), w = world(c.bj, s.pj, c.aj);
-        const double h = quad(c.bi, sv.pi, c.ai).dot(w) + u.dot(quad(c.bj, sv.pj, c.aj)) +
-                         2.0 * rate(c.bi, s.pi, sv.pi, c.ai).dot(rate(c.bj, s.pj, sv.pj, c.aj));
-        g[0] = -h - ptt[0];
-        break;
-      }
-      default: {
-        const Vec14 vl = gather_local(v, c.bi, c.bj);
-        for (int r = 0; r < c.rows(); ++r) {
-          double w[3] = {0, 0, 0};
-          w[r] = 1.0;
-          Mat14 h = Mat14::Zero();
-          constraint_hessian(c, s, w, h);
-          g[r] = -vl.dot(h * vl) - ptt[r];
-        }
-      }
-    }
+    if (gamma)
+      constraint_gamma(c, gather(q, c.bi, c.bj), gather(v, c.bi, c.bj), ptt, gamma + off[k]);
   }
 }
 
@@ -228,7 +184,29 @@ void assemble_force_derivatives(const System& sys, const std::vector<char>& mode
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
     Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
-    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+    if (!f.has_expression()) {
+      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+    } else {
+      // Chain rule through the expression components to the bodies they read (forces.h).
+      const LoadInput in = load_input(sys, f, modes, q, v, t, true);
+      Mat14x3 dqin = Mat14x3::Zero();
+      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in, &dqin);
+      for (size_t r = 0; r < f.reads.size(); ++r)
+        for (int m = 0; m < 7; ++m) {
+          const int col = 7 * f.reads[r] + m, slot = 7 * static_cast<int>(r) + m;
+          for (int l = 0; l < 14; ++l) {
+            const int g = global_index(f.bi, f.bj, l);
+            if (g < 0) continue;
+            double wq = 0, wv = 0;
+            for (int c = 0; c < 3; ++c) {
+              wq += dqin(l, c) * in.dq[c][slot];
+              wv += dqin(l, c) * in.dv[c][slot];
+            }
+            a.add(row0 + g, colq + col, -wq);
+            if (colv >= 0) a.add(row0 + g, colv + col, -wv);
+          }
+        }
+    }
     add_local_block(f.bi, f.bj, -dx, row0, colq, true, a);
     if (colv >= 0) add_local_block(f.bi, f.bj, -dv, row0, colv, true, a);
   }
@@ -280,7 +258,7 @@ void assemble_constraint_hessian(const System& sys, const std::vector<int>& off,
     const Constraint& c = sys.constraints[k];
     Mat14 h = Mat14::Zero();
     constraint_hessian(c, gather(q, c.bi, c.bj), lambda + off[k], h);
-    add_local_block(c.bi, c.bj, h, row0, col0, hessian_touches_r(c), a);
+    add_local_block(c.bi, c.bj, h, row0, col0, constraint_hessian_touches_r(c), a);
   }
 }
 

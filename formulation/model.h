@@ -66,20 +66,40 @@ struct CutSpec {
 };
 
 struct ForceSpec {
-  enum class Type { kSpringDamper, kPointForce, kWheelContact, kUser };
+  enum class Type {
+    kSpringDamper, kPointForce, kWheelContact, kUser,
+    kTorque,              // applied torque on a body about a world or body-fixed axis
+    kJointSpringDamper,   // torque (force) k (q - q0) + c q' on a joint coordinate q
+    kBushing              // linear 6-DOF spring-damper between two body frames
+  };
   std::string name;
   Type type = Type::kSpringDamper;
   std::string body1, point1, body2, point2;
+  // A point given as [x, y, z] in the body frame instead of a name (at_xyz1 / at_xyz2 set).
+  Vec3 xyz1 = Vec3::Zero(), xyz2 = Vec3::Zero();
+  bool at_xyz1 = false, at_xyz2 = false;
   // Spring-damper: tension = stiffness (length - free_length) + damping d(length)/dt.
+  // Joint spring-damper: generalized force -(stiffness (q - free_length) + damping q') on q.
   double stiffness = 0, damping = 0, free_length = 0;
-  // Point force: world components as functions of time.
+  // Point force: components fx fy fz in world axes, or in body1's axes if body_frame (a follower
+  // force). Torque: magnitude fx about `axis` (world axes, or body1's axes if body_frame).
   TimeFunction fx, fy, fz;
+  bool body_frame = false;
+  // A component given as an expression (of t, sensors and `parameters`) instead of a function of
+  // time: expression[k] not empty replaces fx / fy / fz.
+  std::string expression[3];
   // Wheel contact: vertical force max(0, stiffness e), e = radius cos(camber) - (z - ground(t)),
   // at point1 of body1; axis = wheel spin axis in the body frame.
   double radius = 0;
   Vec3 axis = Vec3::UnitY();
   TimeFunction ground;
-  // User force law: registered name and numeric parameters.
+  // Joint spring-damper: the joint coordinate.
+  std::string coordinate;
+  // Bushing: frame 1 at point1 with body1's axes, frame 2 at point2 with body2's axes; stiffness
+  // and damping per frame-1 axis, translational (N/m, N s/m) and rotational (N m/rad, N m s/rad).
+  Vec3 translational_stiffness = Vec3::Zero(), translational_damping = Vec3::Zero();
+  Vec3 rotational_stiffness = Vec3::Zero(), rotational_damping = Vec3::Zero();
+  // User force law: registered name and numeric parameters. Expression loads: named constants.
   std::string law;
   std::map<std::string, double> parameters;
   SourceLocation where;
@@ -97,6 +117,9 @@ struct SensorSpec {
   std::string name;
   Type type = Type::kPosition;
   std::string body, point, target;  // target: coordinate or force name
+  Vec3 xyz = Vec3::Zero();          // the point as [x, y, z] in the body frame (if at_xyz)
+  bool at_xyz = false;
+  bool wrap = false;                // coordinate sensors: wrapped to (-pi, pi] instead of unwrapped
   Vec3 axis = Vec3::UnitX();
   int component = 0;
   std::string expression;
@@ -112,6 +135,7 @@ struct Model {
   std::vector<ForceSpec> forces;
   std::vector<SensorSpec> sensors;
   std::map<std::string, CoordinateSpec> coordinates;
+  std::map<std::string, Vec3> ground_points;  // named points fixed in the world
 };
 
 }  // namespace mbdae

@@ -61,7 +61,7 @@ RedundancyReport find_redundant_constraints(const System& sys, const double* q, 
     for (int comp = 0; comp < 3; ++comp) {
       if (c.type == Constraint::Type::kPoint ? !(c.mask & (1 << comp)) : comp > 0) continue;
       if (dead[off[k] + row]) {
-        report.redundant.push_back(c.label + (c.rows() > 1 ? std::string(" [") + "xyz"[comp] + "]" : ""));
+        report.redundant.push_back(row_label(c, row));
       } else {
         keep_mask |= 1 << comp;
       }

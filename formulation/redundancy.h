@@ -23,6 +23,10 @@ struct RedundancyReport {
 RedundancyReport find_redundant_constraints(const System& sys, const double* q, double t,
                                             double tolerance = 1e-9);
 
+// The former (System&, q, t, bool remove) form: refused at compile time (a bool would silently
+// become the tolerance).
+RedundancyReport find_redundant_constraints(const System& sys, const double* q, double t, bool remove) = delete;
+
 // A new System: `sys` without the redundant equations of `report` (found on `sys`); a point
 // constraint keeps its independent components.
 System without_redundant_constraints(const System& sys, const RedundancyReport& report);

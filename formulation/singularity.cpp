@@ -12,17 +12,17 @@
 namespace mbdae {
 namespace {
 
-// Label of each scalar equation (row) of Phi_q.
-std::vector<std::string> row_labels(const System& sys) {
-  std::vector<std::string> out;
-  for (const Constraint& c : sys.constraints) {
-    if (c.type != Constraint::Type::kPoint) {
-      out.push_back(c.label);
-      continue;
+// Label and group of each scalar equation (row) of Phi_q.
+struct RowNames {
+  std::vector<std::string> label, group;
+};
+RowNames row_names(const System& sys) {
+  RowNames out;
+  for (const Constraint& c : sys.constraints)
+    for (int r = 0; r < c.rows(); ++r) {
+      out.label.push_back(row_label(c, r));
+      out.group.push_back(constraint_group(c));
     }
-    for (int comp = 0; comp < 3; ++comp)
-      if (c.mask & (1 << comp)) out.push_back(c.label + " [" + "xyz"[comp] + "]");
-  }
   return out;
 }
 
@@ -34,26 +34,12 @@ double norm2(const double* x, int n) {
 
 }  // namespace
 
-std::string constraint_group(const std::string& label) {
-  for (const char* prefix : {"drive ", "lock ", "hold "}) {
-    if (label.rfind(prefix, 0) == 0) {
-      const size_t end = label.find(' ', std::string(prefix).size());
-      return label.substr(0, end);
-    }
-  }
-  size_t end = label.find(':');
-  if (end == std::string::npos) end = label.size();
-  const size_t paren = label.find(" (");
-  if (paren < end) end = paren;
-  return label.substr(0, end);
-}
-
 SingularityReport diagnose_singularity(const System& sys, const double* q, double t, double min_weight) {
   SingularityReport report;
   const int nc = sys.num_constraint_rows();
   report.equations = nc;
   if (nc == 0) return report;
-  const std::vector<std::string> labels = row_labels(sys);
+  const RowNames names = row_names(sys);
   std::vector<double> weight(nc, 0.0);
 
   cholmod_common cc;
@@ -116,18 +102,21 @@ SingularityReport diagnose_singularity(const System& sys, const double* q, doubl
     // Exactly dependent: name the equations the redundancy check would remove.
     System copy = sys;
     const RedundancyReport rr = find_redundant_constraints(copy, q, t);
-    for (const auto& r : rr.redundant) report.dependent.push_back({r, 1.0});
+    // (the report names rows by row_label, as names.label does)
+    for (const auto& r : rr.redundant) {
+      const auto it = std::find(names.label.begin(), names.label.end(), r);
+      report.dependent.push_back({r, 1.0, it == names.label.end() ? r : names.group[it - names.label.begin()]});
+    }
   } else {
     std::vector<int> idx;
     for (int i = 0; i < nc; ++i)
       if (weight[i] >= min_weight) idx.push_back(i);
     std::stable_sort(idx.begin(), idx.end(), [&](int i, int j) { return weight[i] > weight[j]; });
-    for (int i : idx) report.dependent.push_back({labels[i], weight[i]});
+    for (int i : idx) report.dependent.push_back({names.label[i], weight[i], names.group[i]});
   }
   for (const auto& d : report.dependent) {
-    const std::string g = constraint_group(d.label);
-    if (std::find(report.constraints.begin(), report.constraints.end(), g) == report.constraints.end())
-      report.constraints.push_back(g);
+    if (std::find(report.constraints.begin(), report.constraints.end(), d.group) == report.constraints.end())
+      report.constraints.push_back(d.group);
   }
   return report;
 }

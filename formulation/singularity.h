@@ -23,6 +23,7 @@ namespace mbdae {
 struct DependentEquation {
   std::string label;  // the constraint's label ("<label> [x]" for one row of a point constraint)
   double weight = 0;  // |y_i| / max_j |y_j|
+  std::string group;  // what it belongs to (constraint_group: "joint rod2_mount", "drive q4")
 };
 
 struct SingularityReport {
@@ -40,9 +41,5 @@ struct SingularityReport {
 // check does (the last equation of each dependent set, weight 1).
 SingularityReport diagnose_singularity(const System& sys, const double* q, double t,
                                        double min_weight = 0.05);
-
-// "joint rod2_mount" for "joint rod2_mount (R1 R3): origin at anchor", "drive q4" for
-// "drive q4 = piecewise linear, 2 knots", "cut ball2" for "cut ball2: coincident points".
-std::string constraint_group(const std::string& label);
 
 }  // namespace mbdae

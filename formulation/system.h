@@ -58,7 +58,25 @@ struct Force {
   Vec3 axis = Vec3::UnitY();  // wheel spin axis in local coordinates
   const UserForceLaw* law = nullptr;
   std::vector<double> parameters;
+  // Point force and torque: components in body axes (frame_i: body1's axes in local coordinates).
+  bool body_frame = false;
+  Mat3 frame_i = Mat3::Identity(), frame_j = Mat3::Identity();
+  // Joint spring-damper: the coordinate it acts on (bi = its parent body, bj = its child body).
+  CoordinateFunction coordinate;
+  // Bushing: stiffness and damping per frame-1 axis (si, sj: the frames' origins).
+  Vec3 kt = Vec3::Zero(), ct = Vec3::Zero(), kr = Vec3::Zero(), cr = Vec3::Zero();
+  // Components given by expressions (empty: fx, fy, fz). Their variables are t (index 0), the
+  // parameters (1 ...) and then the values of the sensors `inputs` (indices into System::sensors);
+  // `reads` lists the bodies those sensors depend on (ascending, at most kMaxLoadReads).
+  Expression expression[3];
+  std::vector<std::string> parameter_names;
+  std::vector<int> inputs, reads;
+  bool has_expression() const {
+    return !expression[0].empty() || !expression[1].empty() || !expression[2].empty();
+  }
 };
+inline constexpr int kMaxLoadReads = 8;
+inline constexpr int kMaxLoadVariables = 48;  // t, parameters and sensors of one load
 
 struct Sensor {
   SensorSpec::Type type = SensorSpec::Type::kPosition;
@@ -68,6 +86,10 @@ struct Sensor {
   int component = 0;
   int target = -1;  // coordinate or force index
   Expression expression;
+  // Rotation coordinate sensors: continuous along a run (multi-turn) unless the scene asks for
+  // `wrap`; without a previous sample the value is taken nearest to `reference` (the initial value).
+  bool unwrap = false;
+  double reference = 0;
 };
 
 struct System {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/errors.h"
 #include "core/ida_driver.h"
 
 namespace mbdae {
@@ -21,6 +22,9 @@ class DecayProblem : public DaeProblem {
   bool step_input = false;       // unit step of u at t = 0.5
   bool end_breakpoint = false;   // declare t = 2 a breakpoint too
   double switch_level = -1;      // > 0: event where y1 crosses it
+  double switch_time = -1;       // > 0: event at this time (g = t - switch_time)
+  double fail_after = 1e300;     // the residual is not computable (recoverable error) after this
+  long residual_calls = 0, jacobian_calls = 0;
   std::vector<double> restart_times;
   std::vector<bool> restart_was_event;
 
@@ -37,11 +41,14 @@ class DecayProblem : public DaeProblem {
     return step_input && tt >= 0.5 ? 1.0 : 0.0;
   }
   int residual(double t, const double* y, const double* yp, double* r) override {
+    ++residual_calls;
+    if (t > fail_after) return 1;
     r[0] = yp[0] + y[0] - u(t);
     r[1] = y[1] - 2 * y[0];
     return 0;
   }
   int jacobian(double, double cj, const double*, const double*, double* v) override {
+    ++jacobian_calls;
     v[0] = 1 + cj;  // (0, 0)
     v[1] = -2;      // (1, 0)
     v[2] = 1;       // (1, 1)
@@ -51,8 +58,10 @@ class DecayProblem : public DaeProblem {
     id[0] = 1;
     id[1] = 0;
   }
-  int num_switches() const override { return switch_level > 0 ? 1 : 0; }
-  void switches(double, const double* y, double* g) override { g[0] = y[0] - switch_level; }
+  int num_switches() const override { return switch_level > 0 || switch_time > 0 ? 1 : 0; }
+  void switches(double t, const double* y, double* g) override {
+    g[0] = switch_time > 0 ? t - switch_time : y[0] - switch_level;
+  }
   void restart(double t, double* y, double* yp, const int* roots) override {
     restart_times.push_back(t);
     restart_was_event.push_back(roots != nullptr);
@@ -160,6 +169,64 @@ TEST(IdaDriver, EventIsLocatedAndRestarted) {
   EXPECT_NEAR(st.event_times[0], std::log(10.0 / 3.0), 1e-9);
   ASSERT_EQ(p.restart_times.size(), 1u);
   EXPECT_TRUE(p.restart_was_event[0]);
+}
+
+// IDA's counters restart at every re-initialization, and the driver adds them up. They must add
+// up to the problem's own count of residual and Jacobian calls, also when an event falls right
+// at the last accepted step (the driver then restarts from that step's state without going back:
+// the statistics of that segment were collected twice).
+TEST(IdaDriver, StatisticsAreCollectedOncePerSegment) {
+  for (double switch_time : {-1.0, 0.7, 1e-14}) {
+    DecayProblem p;
+    p.switch_time = switch_time;
+    p.step_input = true;
+    std::vector<Sample> s;
+    std::vector<double> y;
+    const IdaStats st = run(p, s, y);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(st.residual_evals, p.residual_calls) << "event at " << switch_time;
+    EXPECT_EQ(st.jacobian_evals, p.jacobian_calls) << "event at " << switch_time;
+    EXPECT_EQ(st.event_times.size(), switch_time > 0 ? 1u : 0u);
+    EXPECT_EQ(st.breakpoint_times.size(), 1u);
+  }
+}
+
+// An IDA failure names IDA's flag and keeps IDA's own message (IDAGetReturnFlagName's string is
+// malloc'd: it leaked 24 bytes on every failure, found by the leak checker of the sanitizer build).
+TEST(IdaDriver, FailureNamesTheFlagAndTheTime) {
+  DecayProblem p;
+  p.fail_after = 0;  // no step can be taken
+  std::vector<Sample> s;
+  std::vector<double> y;
+  const IdaStats st = run(p, s, y);
+  ASSERT_FALSE(st.ok);
+  EXPECT_EQ(st.status, "integration_failed");
+  EXPECT_NE(st.message.find("IDA failed at t = 0 "), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("(IDA_REP_RES_ERR)"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("IDA: IDASolve: "), std::string::npos) << st.message;
+  EXPECT_EQ(st.t_reached, 0.0);
+  EXPECT_EQ(s.size(), 1u);  // the initial state
+}
+
+// A SolveError thrown by the output (the multibody front end throws one for a sensor that is not
+// finite) ends the run with its status and message; the sample is not counted as written.
+TEST(IdaDriver, OutputErrorStopsTheRun) {
+  DecayProblem p;
+  std::vector<Sample> s;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.output_step = 0.1;
+  const IdaStats st = integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
+    if (t > 0.45) throw SolveError("non_finite", "sensor x is NaN at t = " + std::to_string(t));
+    s.push_back({t, yy[0], yy[1]});
+    return true;
+  });
+  ASSERT_FALSE(st.ok);
+  EXPECT_EQ(st.status, "non_finite");
+  EXPECT_NE(st.message.find("sensor x is NaN at t = 0.5"), std::string::npos) << st.message;
+  EXPECT_EQ(s.size(), 5u);
+  EXPECT_DOUBLE_EQ(st.t_reached, 0.5);
 }
 
 }  // namespace

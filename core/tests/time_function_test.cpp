@@ -78,5 +78,18 @@ TEST(TimeFunction, StepPiecewiseLinearSinePolynomial) {
   EXPECT_NEAR(c.second_derivative(2), 6, 1e-15);
 }
 
+// A polynomial of degree 50000 (a scene can give that many coefficients): the factor i (i - 1)
+// of the second derivative, 2.5e9, does not fit an int (it overflowed, UBSan: signed integer
+// overflow, and gave a negative second derivative). t^50000 at t = 1: 50000 * 49999.
+TEST(TimeFunction, SecondDerivativeOfAHighDegreePolynomial) {
+  TimeFunction f;
+  f.kind = TimeFunction::Kind::kPolynomial;
+  f.ys.assign(50001, 0.0);
+  f.ys.back() = 1.0;
+  EXPECT_EQ(f.value(1.0), 1.0);
+  EXPECT_EQ(f.derivative(1.0), 50000.0);
+  EXPECT_EQ(f.second_derivative(1.0), 50000.0 * 49999.0);
+}
+
 }  // namespace
 }  // namespace mbdae

@@ -103,84 +103,19 @@ TEST(JacobianFd, ForceJacobians) {
   const RandomState st = random_state(sys, 2);
   ASSERT_EQ(sys.forces.size(), 5u);
   for (const Force& f : sys.forces) {
-    const LocalState x = gather(st.q.data(), f.bi, f.bj), v = gather(st.v.data(), f.bi, f.bj);
-    Vec14 q0 = Vec14::Zero();
-    Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
-    force_eval(f, x, v, 0.2, true, q0, &dx, &dv);
-    EXPECT_GT(q0.norm(), 0) << f.name;
-    auto to_vec = [](const LocalState& s) {
-      Vec14 y;
-      y << s.ri, s.pi, s.rj, s.pj;
-      return y;
-    };
-    auto to_state = [](const Vec14& y) {
-      LocalState t;
-      t.ri = y.head<3>();
-      t.pi = y.segment<4>(3);
-      t.rj = y.segment<3>(7);
-      t.pj = y.tail<4>();
-      return t;
-    };
-    const Vec14 xv = to_vec(x), vv = to_vec(v);
-    const double eps = 1e-6;
-    for (int l = 0; l < 14; ++l) {
-      if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
-      for (int which = 0; which < 2; ++which) {
-        Vec14 p = which ? vv : xv, m = p;
-        p[l] += eps;
-        m[l] -= eps;
-        Vec14 qp = Vec14::Zero(), qm = Vec14::Zero();
-        if (which) {
-          force_eval(f, x, to_state(p), 0.2, true, qp, nullptr, nullptr);
-          force_eval(f, x, to_state(m), 0.2, true, qm, nullptr, nullptr);
-        } else {
-          force_eval(f, to_state(p), v, 0.2, true, qp, nullptr, nullptr);
-          force_eval(f, to_state(m), v, 0.2, true, qm, nullptr, nullptr);
-        }
-        const Vec14 fd = (qp - qm) / (2 * eps);
-        const Mat14& an = which ? dv : dx;
-        for (int k = 0; k < 14; ++k)
-          EXPECT_NEAR(an(k, l), fd(k), 1e-5 * (1 + std::fabs(fd(k))))
-              << f.name << (which ? " dQ/dv " : " dQ/dq ") << k << "," << l;
-      }
-    }
+    const testing::ForceCheck check =
+        testing::check_force_jacobians(f, gather(st.q.data(), f.bi, f.bj), gather(st.v.data(), f.bi, f.bj));
+    EXPECT_GT(check.force_norm, 0) << f.name;
+    EXPECT_LT(check.worst, 1e-5) << check.where;
   }
 }
 
 TEST(JacobianFd, Index3NewtonMatrix) {
   const System sys = build_system(all_types_model());
   Index3Dae dae(sys, 7.0);
-  const RandomState st = random_state(sys, 3);
-  const int n = dae.size();
-  std::vector<double> y, yp;
-  testing::dae_vectors(st, n, false, y, yp);
-  const double cj = 37.0, t = 0.3;
-  const CscPattern& p = dae.jacobian_pattern();
-  std::vector<double> values(p.nnz());
-  dae.jacobian(t, cj, y.data(), yp.data(), values.data());
-  Eigen::MatrixXd an = Eigen::MatrixXd::Zero(n, n);
-  for (int c = 0; c < n; ++c)
-    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) an(p.rowind[k], c) += values[k];
-  std::vector<double> rp(n), rm(n);
-  const double eps = 1e-6;
-  double worst = 0;
-  for (int c = 0; c < n; ++c) {
-    std::vector<double> yy = y, yyp = yp, ym = y, ymp = yp;
-    yy[c] += eps;
-    yyp[c] += cj * eps;
-    ym[c] -= eps;
-    ymp[c] -= cj * eps;
-    dae.residual(t, yy.data(), yyp.data(), rp.data());
-    dae.residual(t, ym.data(), ymp.data(), rm.data());
-    for (int r = 0; r < n; ++r) {
-      const double fd = (rp[r] - rm[r]) / (2 * eps);
-      const double err = std::fabs(an(r, c) - fd) / (1 + std::fabs(fd));
-      worst = std::max(worst, err);
-      EXPECT_LT(err, 1e-6) << "row " << dae.component_name(r) << " col " << dae.component_name(c)
-                           << " analytic " << an(r, c) << " fd " << fd;
-    }
-  }
-  RecordProperty("worst_relative_error", std::to_string(worst));
+  const testing::NewtonCheck check = testing::check_newton_matrix(dae, random_state(sys, 3), false);
+  EXPECT_LT(check.worst, 1e-6) << check.where;
+  RecordProperty("worst_relative_error", testing::sci(check.worst));
 }
 
 }  // namespace

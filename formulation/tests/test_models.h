@@ -2,9 +2,13 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "formulation/forces.h"
 #include "formulation/model.h"
 #include "formulation/system.h"
 
@@ -195,6 +199,92 @@ inline void dae_vectors(const RandomState& s, int n, bool with_mu, std::vector<d
   if (with_mu) std::copy(s.mu.begin(), s.mu.end(), y.begin() + 2 * nq + nc);
   for (int i = 0; i < nq; ++i) yp[i] = s.v[i] + 0.1;
   std::copy(s.a.begin(), s.a.end(), yp.begin() + nq);
+}
+
+// A number in scientific notation, for test properties (std::to_string prints 0.000000).
+inline std::string sci(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2e", x);
+  return b;
+}
+
+// A force element's local Jacobians dQ/dq, dQ/dv (force_eval at t = 0.2, in contact) against
+// central differences: the largest relative difference |analytic - fd| / (1 + |fd|), where, and
+// the size of the generalized force (a zero force would check nothing).
+struct ForceCheck {
+  double worst = 0, force_norm = 0;
+  std::string where;
+};
+inline ForceCheck check_force_jacobians(const Force& f, const LocalState& x, const LocalState& v) {
+  ForceCheck out;
+  Vec14 q0 = Vec14::Zero();
+  Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
+  force_eval(f, x, v, 0.2, true, q0, &dx, &dv);
+  out.force_norm = q0.norm();
+  const double eps = 1e-6;
+  for (int l = 0; l < 14; ++l) {
+    if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
+    for (int which = 0; which < 2; ++which) {
+      Vec14 p = local_vector(which ? v : x), m = p;
+      p[l] += eps;
+      m[l] -= eps;
+      Vec14 qp = Vec14::Zero(), qm = Vec14::Zero();
+      force_eval(f, which ? x : local_state(p), which ? local_state(p) : v, 0.2, true, qp, nullptr, nullptr);
+      force_eval(f, which ? x : local_state(m), which ? local_state(m) : v, 0.2, true, qm, nullptr, nullptr);
+      const Vec14 fd = (qp - qm) / (2 * eps);
+      const Mat14& an = which ? dv : dx;
+      for (int k = 0; k < 14; ++k) {
+        const double err = std::fabs(an(k, l) - fd(k)) / (1 + std::fabs(fd(k)));
+        if (err > out.worst) {
+          out.worst = err;
+          out.where = f.name + (which ? " dQ/dv " : " dQ/dq ") + std::to_string(k) + "," + std::to_string(l);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// The Newton matrix dF/dy + cj dF/dy' of a DAE (its sparse pattern and values) against central
+// differences of its residual at a random state (cj = 37, t = 0.3): the largest relative
+// difference |analytic - fd| / (1 + |fd|) and where it is.
+struct NewtonCheck {
+  double worst = 0;
+  std::string where;
+};
+template <class Dae>
+NewtonCheck check_newton_matrix(Dae& dae, const RandomState& st, bool with_mu) {
+  const int n = dae.size();
+  std::vector<double> y, yp;
+  dae_vectors(st, n, with_mu, y, yp);
+  const double cj = 37.0, t = 0.3, eps = 1e-6;
+  const auto& p = dae.jacobian_pattern();
+  std::vector<double> values(p.nnz());
+  dae.jacobian(t, cj, y.data(), yp.data(), values.data());
+  Eigen::MatrixXd an = Eigen::MatrixXd::Zero(n, n);
+  for (int c = 0; c < n; ++c)
+    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) an(p.rowind[k], c) += values[k];
+  std::vector<double> rp(n), rm(n);
+  NewtonCheck out;
+  for (int c = 0; c < n; ++c) {
+    std::vector<double> yy = y, yyp = yp, ym = y, ymp = yp;
+    yy[c] += eps;
+    yyp[c] += cj * eps;
+    ym[c] -= eps;
+    ymp[c] -= cj * eps;
+    dae.residual(t, yy.data(), yyp.data(), rp.data());
+    dae.residual(t, ym.data(), ymp.data(), rm.data());
+    for (int r = 0; r < n; ++r) {
+      const double fd = (rp[r] - rm[r]) / (2 * eps);
+      const double err = std::fabs(an(r, c) - fd) / (1 + std::fabs(fd));
+      if (err > out.worst) {
+        out.worst = err;
+        out.where = "row " + dae.component_name(r) + " col " + dae.component_name(c) + " analytic " +
+                    std::to_string(an(r, c)) + " fd " + std::to_string(fd);
+      }
+    }
+  }
+  return out;
 }
 
 // Crank (length 1) and rocker (length 1) on revolute joints about z at (0,0,0) and (2,0,0),

@@ -1,0 +1,95 @@
+#include "cases/cli_options.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "cases/field_ranges.h"
+
+namespace mbdae {
+namespace {
+
+// A number as the scene loader reads one: all of the text, finite.
+std::string read_number(const std::string& option, const std::string& text, double& v) {
+  char* end = nullptr;
+  v = std::strtod(text.c_str(), &end);
+  if (text.empty() || !end || *end != '\0') return option + ": expected a number, got '" + text + "'";
+  if (!std::isfinite(v)) return option + ": '" + text + "' is not a finite number";
+  return "";
+}
+
+std::string read_option(const std::vector<std::string>& args, size_t& i, CommandLine& cl) {
+  const std::string& a = args[i];
+  RunOptions& opt = cl.options;
+  const bool has_value = i + 1 < args.size();
+  if (a == "--out" && has_value) {
+    cl.out_dir = args[++i];
+    return cl.out_dir.empty() ? "--out: expected a folder, got ''" : "";
+  }
+  if ((a == "--rtol" || a == "--atol" || a == "--output-step") && has_value) {
+    double v = 0;
+    std::string why = read_number(a, args[++i], v);
+    if (why.empty() && a == "--rtol" && !rtol_range_error(v).empty()) why = a + ": " + rtol_range_error(v);
+    if (why.empty() && a == "--atol" && !atol_range_error(v).empty()) why = a + ": " + atol_range_error(v);
+    if (why.empty() && a == "--output-step" && !output_step_range_error(v, 0, 0).empty())
+      why = a + ": " + output_step_range_error(v, 0, 0);
+    (a == "--rtol" ? opt.rtol : a == "--atol" ? opt.atol : opt.output_step) = v;
+    return why;
+  }
+  if (a == "--formulation" && has_value) {
+    opt.formulation = args[++i];
+    const std::vector<std::string> known = formulations();
+    if (std::find(known.begin(), known.end(), opt.formulation) != known.end()) return "";
+    std::string list;
+    for (const auto& f : known) list += (list.empty() ? "" : ", ") + f;
+    return "--formulation: expected one of " + list + ", got '" + opt.formulation + "'";
+  }
+  if (a == "--quiet") {
+    opt.verbose = opt.progress = false;
+    return "";
+  }
+  cl.show_usage = true;
+  return has_value || a.rfind("--", 0) != 0 ? "unknown argument '" + a + "'" : a + ": a value is missing";
+}
+
+}  // namespace
+
+void print_usage() {
+  std::string names;  // the registered formulations: index3|index2-ggl|...
+  for (const std::string& f : formulations()) names += (names.empty() ? "" : "|") + f;
+  std::fprintf(stderr,
+               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
+               "                  [--output-step DT]\n"
+               "                  [--formulation %s]\n"
+               "       mbdae check SCENE.yaml\n", names.c_str());
+}
+
+std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl) {
+  if (args.size() < 2 || (args[0] != "run" && args[0] != "check")) {
+    cl.show_usage = true;
+    return "expected 'run SCENE.yaml' or 'check SCENE.yaml'";
+  }
+  cl.check_only = args[0] == "check";
+  cl.scene_path = args[1];
+  cl.options.verbose = cl.options.progress = true;
+  for (size_t i = 2; i < args.size(); ++i) {
+    const std::string why = read_option(args, i, cl);
+    if (!why.empty()) return why;
+  }
+  if (!cl.check_only && cl.out_dir.empty()) return "--out DIR is required";
+  return "";
+}
+
+std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& opt) {
+  std::vector<std::string> out;
+  if (!(opt.output_step > 0)) return out;
+  for (const AnalysisStep& s : scene.steps) {
+    if (s.type != AnalysisStep::Type::kKinematics && s.type != AnalysisStep::Type::kDynamics) continue;
+    const std::string why = output_step_range_error(opt.output_step, s.t0, s.t_end);
+    if (!why.empty()) out.push_back("--output-step: " + why);
+  }
+  return out;
+}
+
+}  // namespace mbdae

@@ -1,0 +1,31 @@
+// The command line of mbdae (cases/main.cpp):
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet]
+//                         [--formulation index3|index2-ggl|index1|penalty]
+//   mbdae check SCENE.yaml
+// Overrides are checked with the scene fields' own range checks (cases/field_ranges.h): the
+// tolerances as soon as they are read, the output step against each integration step's time
+// span once the scene is loaded.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cases/mbdae.h"
+
+namespace mbdae {
+
+struct CommandLine {
+  bool check_only = false;
+  std::string scene_path;
+  std::string out_dir;  // --out: results.csv and summary.json go there
+  RunOptions options;
+  bool show_usage = false;  // after an error: the usage text helps
+};
+
+// Reads the arguments after the program name; returns "" or the usage error (exit code 1).
+std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl);
+// The command-line overrides checked against the scene's integration steps; empty if fine.
+std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& options);
+void print_usage();
+
+}  // namespace mbdae

@@ -1,0 +1,19 @@
+// Range checks shared by the scene loader (cases/scene_loader.cpp) and the command-line
+// overrides (cases/cli_options.cpp), so that a value refused in a scene is refused with the same
+// message on the command line. Each returns the message for a value out of range, "" if it is fine.
+#pragma once
+
+#include <string>
+
+namespace mbdae {
+
+constexpr double kMaxOutputRows = 1e8;  // output_step may not ask for more rows than this
+
+std::string format_number(double x);  // as in messages: shortest of %g-like text (1e-300, 0.5)
+std::string rtol_range_error(double rtol);
+std::string atol_range_error(double atol);
+// Positive, and at most kMaxOutputRows samples over [t0, t_end] (a span that is not valid is
+// reported elsewhere: only the sign is checked then).
+std::string output_step_range_error(double output_step, double t0, double t_end);
+
+}  // namespace mbdae
