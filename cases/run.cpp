@@ -219,7 +219,7 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
       s->end(result);
     } catch (const OutputError& e) {  // results.csv could not be completed: say so in the summary
       if (s == sinks.back()) throw;
-      output_failed(c, e.what());
+      if (result.exit_code == 0) output_failed(c, e.what());  // else the first failure stands
     }
   }
   return result;
