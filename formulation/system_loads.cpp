@@ -104,7 +104,8 @@ void resolve_load_expressions(const ForceSpec& fs, const System& sys, const Name
         return load_variable(sys, sensor_of, is_expression_load, n, f);
       });
     } catch (const ExpressionError& e) {
-      fail(fs.where, field, std::string(e.what()) + " (names are t, the force's parameters and sensors)");
+      const std::string m = e.what();
+      fail(fs.where, field, m.find("unknown name") == 0 ? m + " (names are t, the force's parameters and sensors)" : m);
     }
   }
   for (int s : f.inputs) sensor_bodies(sys, sys.sensors[s], f.reads);
