@@ -24,8 +24,8 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
   RunOptions& opt = cl.options;
   const bool has_value = i + 1 < args.size();
   if (a == "--out" && has_value) {
-    opt.out_dir = args[++i];
-    return opt.out_dir.empty() ? "--out: expected a folder, got ''" : "";
+    cl.out_dir = args[++i];
+    return cl.out_dir.empty() ? "--out: expected a folder, got ''" : "";
   }
   if ((a == "--rtol" || a == "--atol" || a == "--output-step") && has_value) {
     double v = 0;
@@ -70,11 +70,13 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
 }  // namespace
 
 void print_usage() {
+  std::string names;  // the registered formulations: index3|index2-ggl|...
+  for (const std::string& f : formulations()) names += (names.empty() ? "" : "|") + f;
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
                "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
-               "                  [--formulation index3|index2-ggl|index1|penalty]\n"
-               "       mbdae check SCENE.yaml\n");
+               "                  [--formulation %s]\n"
+               "       mbdae check SCENE.yaml\n", names.c_str());
 }
 
 std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl) {
@@ -85,12 +87,11 @@ std::string parse_command_line(const std::vector<std::string>& args, CommandLine
   cl.check_only = args[0] == "check";
   cl.scene_path = args[1];
   cl.options.verbose = cl.options.progress = true;
-  cl.options.keep_rows = false;
   for (size_t i = 2; i < args.size(); ++i) {
     const std::string why = read_option(args, i, cl);
     if (!why.empty()) return why;
   }
-  if (!cl.check_only && cl.options.out_dir.empty()) return "--out DIR is required";
+  if (!cl.check_only && cl.out_dir.empty()) return "--out DIR is required";
   return "";
 }
 

@@ -18,6 +18,7 @@ namespace mbdae {
 struct CommandLine {
   bool check_only = false;
   std::string scene_path;
+  std::string out_dir;  // --out: results.csv and summary.json go there
   RunOptions options;
   bool show_usage = false;  // after an error: the usage text helps
   bool error_estimate = false;  // --error-estimate (cases/error_estimate.h)

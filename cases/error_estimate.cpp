@@ -70,8 +70,6 @@ ErrorEstimate estimate_global_error(const Scene& scene, const RunOptions& option
   e.rtol = step->value("rtol", 0.0);
   e.atol = step->value("atol", 0.0);
   RunOptions tight = options;
-  tight.out_dir.clear();
-  tight.keep_rows = true;
   tight.verbose = tight.progress = false;
   tight.rtol = e.reference_rtol = std::max(1e-14, e.rtol / factor);
   tight.atol = e.reference_atol = e.atol / factor;
@@ -91,13 +89,13 @@ ErrorEstimate estimate_global_error(const Scene& scene, const RunOptions& option
   return e;
 }
 
-int run_with_error_estimate(const Scene& scene, RunOptions options) {
-  options.keep_rows = true;
-  Result r = run(scene, options);
-  if (!r.ok()) return r.exit_code;
+Result run_with_error_estimate(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks,
+                               const std::string& summary_path) {
+  Result r = run(scene, options, sinks);
+  if (!r.ok()) return r;
   const ErrorEstimate e = estimate_global_error(scene, options, r);
   r.summary["error_estimate"] = e.to_json();
-  if (!options.out_dir.empty()) write_json_file(options.out_dir + "/summary.json", r.summary);
+  if (!summary_path.empty()) write_json_file(summary_path, r.summary);
   if (e.reference_status != "ok")
     std::fprintf(stderr, "mbdae: warning: no error estimate, the run at rtol %g failed (%s)\n", e.reference_rtol,
                  e.reference_status.c_str());
@@ -107,7 +105,7 @@ int run_with_error_estimate(const Scene& scene, RunOptions options) {
                    "mbdae: warning: sensor %s: estimated global error %.3g is %.3g times rtol %g of its scale %.3g "
                    "(the tolerance promises at most 10): tighten rtol\n",
                    e.sensors[k].c_str(), e.error[k], e.error[k] / (e.rtol * e.scale[k]), e.rtol, e.scale[k]);
-  return r.exit_code;
+  return r;
 }
 
 }  // namespace mbdae

@@ -26,13 +26,14 @@ struct ErrorEstimate {
 // Whether the scene asks for an estimate (error_estimate: true on an integration step).
 bool error_estimate_requested(const Scene& scene);
 
-// Repeats the run `first` (made with `options`, keep_rows set) at rtol / factor, atol / factor.
+// Repeats the run `first` (made with `options`) at rtol / factor, atol / factor.
 ErrorEstimate estimate_global_error(const Scene& scene, const RunOptions& options, const Result& first,
                                     double factor = 100.0);
 
-// The command line's run with an estimate: runs, estimates, adds "error_estimate" to the result's
-// summary (and summary.json when options.out_dir is set), and warns on stderr for every sensor
-// over its promise. Returns the run's exit code.
-int run_with_error_estimate(const Scene& scene, RunOptions options);
+// The command line's run with an estimate: runs through `sinks`, estimates, adds "error_estimate"
+// to the result's summary (rewriting `summary_path` when it is not empty), and warns on stderr
+// for every sensor over its promise.
+Result run_with_error_estimate(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks,
+                               const std::string& summary_path);
 
 }  // namespace mbdae

@@ -12,8 +12,8 @@
 #include "cases/animation_sink.h"
 #include "cases/cli_options.h"
 #include "cases/error_estimate.h"
-#include "cases/run_scene.h"
-#include "cases/scene.h"
+#include "cases/mbdae.h"
+#include "cases/sinks.h"
 #include "cases/signals.h"
 #include "core/errors.h"
 #include "core/output.h"
@@ -40,15 +40,18 @@ int main(int argc, char** argv) {
     const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, opt);
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
-    const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(opt.out_dir, {"results.csv", "summary.json"});
-    if (cl.error_estimate || mbdae::error_estimate_requested(scene)) return mbdae::run_with_error_estimate(scene, opt);
+    const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(cl.out_dir, {"results.csv", "summary.json"});
+    mbdae::CsvSink csv(cl.out_dir + "/results.csv");
+    mbdae::SummarySink summary(cl.out_dir + "/summary.json");
+    std::vector<mbdae::Sink*> sinks = {&csv, &summary};
     std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/animation_sink.h)
     if (cl.animation || scene.animation.write)
-      anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, cl.animation_rate);
-    std::vector<mbdae::Sink*> sinks;
+      anim = std::make_unique<mbdae::AnimationSink>(scene, cl.out_dir, cl.animation_rate);
     if (anim) sinks.push_back(anim.get());
-    const mbdae::Result r = mbdae::run(scene, opt, sinks);
-    const bool interrupted = r.summary.value("status", std::string()) == "interrupted";
+    const bool estimate = cl.error_estimate || mbdae::error_estimate_requested(scene);
+    const mbdae::Result r = estimate ? mbdae::run_with_error_estimate(scene, opt, sinks, cl.out_dir + "/summary.json")
+                                     : mbdae::run(scene, opt, sinks);  // load, run, write
+    const bool interrupted = r.status == "interrupted";
     return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;
   } catch (const mbdae::SceneError& e) {
     for (const auto& m : e.messages) std::fprintf(stderr, "%s\n", m.c_str());

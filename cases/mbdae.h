@@ -51,10 +51,6 @@ struct RunOptions {
   // Set from another thread (or a signal handler) to stop at the next step; the run then ends
   // with status "interrupted" and keeps what it computed.
   const std::atomic<bool>* stop = nullptr;
-
-  // Command-line conveniences kept while the CLI moves to sinks (cases/main.cpp):
-  std::string out_dir;      // non-empty: results.csv and summary.json into this folder
-  bool keep_rows = true;    // keep the sample rows in Result::values
 };
 
 // The names of the registered formulations (index3, index2-ggl, index1, penalty, ...).
@@ -67,7 +63,8 @@ struct Result {
   int exit_code = 0;               // the CLI's: 0 ok, 3 solve failure (docs/errors.md)
   std::vector<std::string> columns;  // "t", then the output sensors
   std::vector<std::string> units;    // SI unit of each column ("s", "m", "rad", "N", "1", ...)
-  // The samples, one vector per column (column-major: each column contiguous).
+  // The samples, one vector per column (column-major: each column contiguous; reserved for the
+  // expected sample count when the integration starts).
   std::vector<std::vector<double>> data;
   nlohmann::ordered_json summary;  // the content of summary.json (statistics, coordinates, status)
   std::vector<double> q;           // final positions (7 per body)
@@ -76,6 +73,8 @@ struct Result {
   size_t rows() const { return data.empty() ? 0 : data[0].size(); }
   int column_index(const std::string& name) const;  // -1 if none
   const std::vector<double>& column(const std::string& name) const;  // throws std::out_of_range
+  std::vector<double> row(size_t i) const;                 // sample i, one value per column (a copy)
+  std::vector<std::vector<double>> row_major() const;      // every sample as a row (a copy)
 };
 
 // What a sink is told before the first sample of an integration step.
@@ -99,7 +98,7 @@ struct Sample {
   double input_time = 0;  // time at which inputs (ground, drives) were evaluated
 };
 
-// An output writer. begin() and sample() may throw (std::runtime_error with the file named):
+// An output writer (cases/sinks.h: CsvSink, SummarySink). begin() and sample() may throw (std::runtime_error with the file named):
 // the run then stops with status "output_failed" and end() is still called.
 class Sink {
  public:

@@ -23,6 +23,7 @@
 #include "cases/scene_validation.h"
 #include "core/errors.h"
 #include "core/expression.h"
+#include "formulation/formulation_registry.h"
 
 namespace mbdae {
 
@@ -870,11 +871,8 @@ struct Loader {
     if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
-    if (has(n, "formulation") && n["formulation"].IsScalar() && s.formulation != "index3" &&
-        s.formulation != "index3-positions" && s.formulation != "index2-ggl" && s.formulation != "index1" &&
-        s.formulation != "penalty")
-      error(n["formulation"], "formulation",
-            "unknown formulation " + quote(s.formulation) + " (index3, index3-positions, index2-ggl, index1, penalty)");
+    if (has(n, "formulation") && n["formulation"].IsScalar() && !find_formulation(s.formulation))
+      error(n["formulation"], "formulation", "unknown formulation " + quote(s.formulation) + " (" + formulation_names() + ")");
     if (integrates && !s.quiet_sensors.empty() && !has(n, "quiet_until"))
       error(n["quiet_sensors"], "quiet_until", "missing (quiet_sensors are watched until quiet_until)");
     return s;

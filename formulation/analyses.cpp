@@ -29,7 +29,18 @@ AssemblyResult assemble_positions(const System& sys, const std::vector<int>& hel
   return out;
 }
 
-EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
+System with_force_parameters(const System& sys, const std::vector<std::pair<int, std::string>>& parameters,
+                             const std::vector<double>& values) {
+  System out = sys;
+  for (size_t p = 0; p < parameters.size() && p < values.size(); ++p)
+    *force_parameter(out.forces[parameters[p].first], parameters[p].second) = values[p];
+  return out;
+}
+
+// The Newton iteration's merit is max(|Q residual| / force scale, |Phi|). The force scale is
+// that of the iterate (max(1, |Q|) at x), and a trial point is compared on the same scale: a
+// scale taken over every evaluation (trials included) changed between the two merits compared.
+EquilibriumResult solve_equilibrium(const System& sys_in, std::vector<double>& q,
                                     const EquilibriumOptions& o) {
   EquilibriumResult res;
   System sys = sys_in;
@@ -65,10 +76,11 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
       *force_parameter(sys.forces[o.parameters[p].first], o.parameters[p].second) = xv[nq + nc + p];
   };
   std::vector<double> f(n), work(nq);
-  double force_scale = 1.0;
+  // Returns the force scale at xv, max(1, |Q(xv)|).
   auto residual = [&](const double* xv, double* out) {
     set_parameters(xv);
     generalized_forces(sys, modes, xv, zeros.data(), o.t, work.data());
+    double force_scale = 1.0;
     for (int i = 0; i < nq; ++i) {
       out[i] = -work[i];
       force_scale = std::fmax(force_scale, std::fabs(work[i]));
@@ -76,6 +88,7 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
     add_constraint_forces(sys, off, xv, xv + nq, out);
     constraint_values(sys, off, xv, o.t, out + nq);
     for (int p = 0; p < np; ++p) out[nq + nc + p] = xv[nq + release_rows[p]];
+    return force_scale;
   };
   auto assemble = [&](const double* xv, SparseAssembler& a) {
     set_parameters(xv);
@@ -101,14 +114,14 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
   klu.analyze(a.pattern());
   std::vector<double> values(a.pattern().nnz()), dx(n), trial(n), ftrial(n);
 
-  auto norms = [&](const double* fv, double& fr, double& cr) {
+  auto norms = [&](const double* fv, double force_scale, double& fr, double& cr) {
     fr = max_abs(fv, nq) / force_scale;
     cr = max_abs(fv + nq, nc);
     for (int p = 0; p < np; ++p) fr = std::fmax(fr, std::fabs(fv[nq + nc + p]) / force_scale);
   };
-  residual(x.data(), f.data());
+  double scale = residual(x.data(), f.data());
   double fr, cr;
-  norms(f.data(), fr, cr);
+  norms(f.data(), scale, fr, cr);
   auto merit = [&](double frv, double crv) { return std::fmax(frv, crv); };
   for (res.iterations = 0; res.iterations < o.max_iterations; ++res.iterations) {
     if (fr < 1e-13 && cr < 1e-13) break;
@@ -119,12 +132,15 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
       break;
     }
     for (int i = 0; i < n; ++i) dx[i] = -f[i];
-    klu.solve(dx.data());
-    double alpha = 1.0, frt = fr, crt = cr;
+    if (!klu.solve(dx.data())) {
+      res.message = "equilibrium Newton step: the KLU solve failed";
+      break;
+    }
+    double alpha = 1.0, frt = fr, crt = cr, trial_scale = scale;
     for (int ls = 0; ls < 20; ++ls, alpha *= 0.5) {
       for (int i = 0; i < n; ++i) trial[i] = x[i] + alpha * dx[i];
-      residual(trial.data(), ftrial.data());
-      norms(ftrial.data(), frt, crt);
+      trial_scale = residual(trial.data(), ftrial.data());
+      norms(ftrial.data(), scale, frt, crt);  // on the iterate's scale, as fr
       if (merit(frt, crt) < merit(fr, cr) || merit(frt, crt) < 1e-12) break;
     }
     if (!(merit(frt, crt) < merit(fr, cr))) {
@@ -133,13 +149,13 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
     }
     x = trial;
     f = ftrial;
-    fr = frt;
-    cr = crt;
+    scale = trial_scale;
+    norms(f.data(), scale, fr, cr);
   }
   set_parameters(x.data());
   res.force_residual = fr;
   res.constraint_residual = cr;
-  res.converged = fr < 1e-10 && cr < 1e-12;
+  res.converged = res.message.empty() && fr < 1e-10 && cr < 1e-12;
   if (!res.converged && res.message.empty()) {
     std::ostringstream os;
     os << "equilibrium did not converge: relative force residual " << fr << ", constraint residual " << cr;
@@ -148,7 +164,6 @@ EquilibriumResult solve_equilibrium(System& sys_in, std::vector<double>& q,
   std::copy(x.begin(), x.begin() + nq, q.begin());
   for (int p = 0; p < np; ++p) {
     res.parameter_values.push_back(x[nq + nc + p]);
-    *force_parameter(sys_in.forces[o.parameters[p].first], o.parameters[p].second) = x[nq + nc + p];
   }
   for (size_t h = 0; h < o.hold.size(); ++h) res.hold_reactions.push_back(x[nq + off[first_hold + h]]);
   return res;

@@ -45,8 +45,13 @@ struct EquilibriumResult {
   std::string message;
 };
 
-// Solves in place: q (and sys's force parameters) are updated.
-EquilibriumResult solve_equilibrium(System& sys, std::vector<double>& q,
+// Solves for q (updated in place) and the unknown parameters (returned in parameter_values;
+// `sys` is not changed: with_force_parameters() builds the system that has them).
+EquilibriumResult solve_equilibrium(const System& sys, std::vector<double>& q,
                                     const EquilibriumOptions& options);
+
+// A new System: `sys` with force parameters (force index, name) set to `values`.
+System with_force_parameters(const System& sys, const std::vector<std::pair<int, std::string>>& parameters,
+                             const std::vector<double>& values);
 
 }  // namespace mbdae

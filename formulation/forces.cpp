@@ -2,31 +2,26 @@
 
 #include <cmath>
 #include <map>
-#include <mutex>
 
 namespace mbdae {
 namespace {
 constexpr int kRi = 0, kPi4 = 3, kRj = 7, kPj = 10;
 
-std::map<std::string, UserForceLaw>& registry() {
-  static std::map<std::string, UserForceLaw> r;
-  return r;
+// The force laws, built once on first use and never changed afterwards (no global mutable
+// state: runs in several threads read it at once). A new law is one more entry here.
+// Built-in example: a linear bushing. With d = P2 - P1, the force on point 1 is f = k d + c d_dot,
+// which pulls it towards point 2 (restoring); point 2 gets -f.
+std::map<std::string, UserForceLaw> builtin_laws() {
+  std::map<std::string, UserForceLaw> laws;
+  UserForceLaw bushing;
+  bushing.name = "linear_bushing";
+  bushing.parameter_names = {"stiffness", "damping"};
+  bushing.force = [](const Vec3& d, const Vec3& dd, double, const double* p) -> Vec3 {
+    return p[0] * d + p[1] * dd;  // pulls point 1 towards point 2
+  };
+  laws[bushing.name] = bushing;
+  return laws;
 }
-
-// Built-in example of a user law: a linear bushing. With d = P2 - P1, the force on point 1 is
-// f = k d + c d_dot, which pulls it towards point 2 (restoring); point 2 gets -f.
-struct BuiltinLaws {
-  BuiltinLaws() {
-    UserForceLaw bushing;
-    bushing.name = "linear_bushing";
-    bushing.parameter_names = {"stiffness", "damping"};
-    bushing.force = [](const Vec3& d, const Vec3& dd, double, const double* p) -> Vec3 {
-      return p[0] * d + p[1] * dd;  // pulls point 1 towards point 2
-    };
-    registry()[bushing.name] = bushing;
-  }
-};
-BuiltinLaws builtin_laws;
 
 Vec3 point(int b, const Vec3& r, const Vec4& p, const Vec3& s) {
   return b < 0 ? s : Vec3(r + rotate(p, s));
@@ -286,15 +281,10 @@ LocalState local_state(const Vec14& y) {
   return s;
 }
 
-void register_force_law(const UserForceLaw& law) {
-  static std::mutex m;
-  std::lock_guard<std::mutex> lock(m);
-  registry()[law.name] = law;
-}
-
 const UserForceLaw* find_force_law(const std::string& name) {
-  auto it = registry().find(name);
-  return it == registry().end() ? nullptr : &it->second;
+  static const std::map<std::string, UserForceLaw> laws = builtin_laws();  // thread-safe initialization
+  auto it = laws.find(name);
+  return it == laws.end() ? nullptr : &it->second;
 }
 
 void force_eval(const Force& f, const LocalState& x, const LocalState& v, double t,

@@ -52,7 +52,7 @@ struct UserForceLaw {
                      Mat3& df_dd, Mat3& df_dddot)>
       jacobian;  // optional
 };
-void register_force_law(const UserForceLaw& law);
+// The law named `name` from the immutable table in forces.cpp (safe from any thread), or null.
 const UserForceLaw* find_force_law(const std::string& name);
 
 // A local state as the 14-vector (r_i, p_i, r_j, p_j), and back.

@@ -1,6 +1,7 @@
 #include "formulation/multibody_dae.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "core/errors.h"
 #include "formulation/constraint_rates.h"
@@ -219,14 +220,38 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
       max_condition_time = t;
     }
   }
-  if (project) {
-    if (violation > 1e-14) aug_.positions(q.data(), t, 1e-14, 5);
+  // A solve that fails is reported in output_failure (the run stops there): its numbers are
+  // not written as if they were the state. The position projection asks for 1e-14 but is
+  // accepted at the rounding level of the coordinates (position_noise).
+  output_failure.clear();
+  char buf[200];
+  bool finite = true;
+  for (int i = 0; i < nq_; ++i) finite = finite && std::isfinite(q[i]) && std::isfinite(v[i]);
+  if (!finite) {
+    std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the interpolated positions are not finite", t_in);
+    output_failure = buf;
+  }
+  if (project && output_failure.empty()) {
+    if (violation > 1e-14) {
+      const PositionSolveResult r = aug_.positions(q.data(), t, 1e-14, 5);
+      if (!(r.residual <= std::fmax(1e-14, position_noise(q.data())))) {
+        std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the position constraints did not converge (max |Phi| %.3g after %d iterations)",
+                      t_in, r.residual, r.iterations);
+        output_failure = buf;
+      }
+    }
     velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
     double vmax = 1.0;
     for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
-    if (max_abs(out_phi_.data(), nc_) > 1e-14 * vmax) aug_.velocities(q.data(), t, v.data());
+    if (output_failure.empty() && max_abs(out_phi_.data(), nc_) > 1e-14 * vmax && !aug_.velocities(q.data(), t, v.data())) {
+      std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the velocity constraints failed (singular constraint Jacobian)", t_in);
+      output_failure = buf;
+    }
   }
-  if (output_accelerations) aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr);
+  if (output_failure.empty() && output_accelerations && !aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr)) {
+    std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the acceleration solve failed (singular augmented matrix)", t_in);
+    output_failure = buf;
+  }
   return violation;
 }
 

@@ -74,6 +74,9 @@ class MultibodyDae : public DaeProblem {
   // else from the derivative of the positions' interpolant, q' in y'.
   double consistent_output(double t, const double* y, const double* yp, std::vector<double>& q,
                            std::vector<double>& v, std::vector<double>& a, bool project);
+  // Empty, or why the last consistent_output() could not give a consistent state (a projection
+  // or the acceleration solve failed, or y was not finite): its numbers must not be used.
+  std::string output_failure;
   // Whether v is in the local error test (then its interpolant is error-controlled).
   virtual bool velocities_error_tested() const = 0;
   // Whether output velocities come from the interpolant of v (else from q' in y').

@@ -11,12 +11,13 @@
 
 namespace mbdae {
 
-RedundancyReport find_redundant_constraints(System& sys, const double* q, double t, bool remove,
+RedundancyReport find_redundant_constraints(const System& sys, const double* q, double t,
                                             double tolerance) {
   RedundancyReport report;
   const std::vector<int> off = constraint_offsets(sys);
   const int nc = off.back();
   report.equations = nc;
+  report.keep.assign(sys.constraints.size(), 1);
   if (nc == 0) return report;
 
   // A = Phi_q^T (nq x nc), one column per equation, normalized.
@@ -53,10 +54,9 @@ RedundancyReport find_redundant_constraints(System& sys, const double* q, double
   cholmod_l_free_sparse(&a, &cc);
   cholmod_l_finish(&cc);
 
-  // Report, and drop what is asked.
-  std::vector<Constraint> kept;
+  // Report, and say what to keep.
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
-    Constraint c = sys.constraints[k];
+    const Constraint& c = sys.constraints[k];
     int keep_mask = 0, row = 0;
     for (int comp = 0; comp < 3; ++comp) {
       if (c.type == Constraint::Type::kPoint ? !(c.mask & (1 << comp)) : comp > 0) continue;
@@ -67,13 +67,23 @@ RedundancyReport find_redundant_constraints(System& sys, const double* q, double
       }
       ++row;
     }
-    if (!remove) continue;
-    if (keep_mask == 0) continue;
-    if (c.type == Constraint::Type::kPoint) c.mask = keep_mask;
-    kept.push_back(c);
+    report.keep[k] = c.type == Constraint::Type::kPoint ? keep_mask : keep_mask != 0;
   }
-  if (remove) sys.constraints = kept;
   return report;
+}
+
+System without_redundant_constraints(const System& sys, const RedundancyReport& report) {
+  if (report.keep.size() != sys.constraints.size())
+    throw std::logic_error("without_redundant_constraints: the report is of another system");
+  System out = sys;
+  out.constraints.clear();
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    if (report.keep[k] == 0) continue;
+    Constraint c = sys.constraints[k];
+    if (c.type == Constraint::Type::kPoint) c.mask = report.keep[k];
+    out.constraints.push_back(c);
+  }
+  return out;
 }
 
 }  // namespace mbdae

@@ -14,11 +14,21 @@ namespace mbdae {
 struct RedundancyReport {
   int equations = 0, rank = 0;
   std::vector<std::string> redundant;  // labels of the redundant equations ("<label> [row k]")
+  // Per constraint of the analysed system, the rows to keep: a point constraint's component
+  // mask (bit k: component k), 1 for other constraints; 0 drops the constraint.
+  std::vector<int> keep;
 };
 
-// Analyzes Phi_q at q (t for drivers); with `remove`, drops the redundant equations from sys
-// (a point constraint keeps its independent components).
-RedundancyReport find_redundant_constraints(System& sys, const double* q, double t, bool remove,
+// Analyzes Phi_q at q (t for drivers). The system is not changed: what to remove is returned.
+RedundancyReport find_redundant_constraints(const System& sys, const double* q, double t,
                                             double tolerance = 1e-9);
+
+// The former (System&, q, t, bool remove) form: refused at compile time (a bool would silently
+// become the tolerance).
+RedundancyReport find_redundant_constraints(const System& sys, const double* q, double t, bool remove) = delete;
+
+// A new System: `sys` without the redundant equations of `report` (found on `sys`); a point
+// constraint keeps its independent components.
+System without_redundant_constraints(const System& sys, const RedundancyReport& report);
 
 }  // namespace mbdae

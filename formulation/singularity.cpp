@@ -101,7 +101,7 @@ SingularityReport diagnose_singularity(const System& sys, const double* q, doubl
   if (report.rank < nc) {
     // Exactly dependent: name the equations the redundancy check would remove.
     System copy = sys;
-    const RedundancyReport rr = find_redundant_constraints(copy, q, t, false);
+    const RedundancyReport rr = find_redundant_constraints(copy, q, t);
     // (the report names rows by row_label, as names.label does)
     for (const auto& r : rr.redundant) {
       const auto it = std::find(names.label.begin(), names.label.end(), r);

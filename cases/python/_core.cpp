@@ -14,11 +14,28 @@
 #include <pybind11/stl.h>
 
 #include "cases/mbdae.h"
+#include "cases/sinks.h"
+#include "core/output.h"
 #include "core/errors.h"
 
 namespace py = pybind11;
 
 namespace {
+
+// The API's RunOptions plus the folder that run(out=) writes results.csv and summary.json to
+// (through the CLI's sinks, cases/sinks.h).
+struct PyRunOptions : mbdae::RunOptions {
+  std::string out_dir;
+};
+
+// mbdae::run with the CLI's sinks when an output folder is given.
+mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
+  if (options.out_dir.empty()) return mbdae::run(scene, options);
+  mbdae::prepare_output_folder(options.out_dir);
+  mbdae::CsvSink csv(options.out_dir + "/results.csv");
+  mbdae::SummarySink summary(options.out_dir + "/summary.json");
+  return mbdae::run(scene, options, {&csv, &summary});
+}
 
 // A column of a Result as a read-only numpy array over the Result's own memory (no copy): the
 // array keeps the Python Result object (and so the C++ Result) alive.
@@ -51,16 +68,16 @@ const char* step_type_name(mbdae::AnalysisStep::Type t) {
 // the GIL released, so runs in Python threads proceed in parallel. In the main thread the run goes
 // to a helper thread while this one checks for Ctrl-C every 50 ms: a signal stops the run at its
 // next step (RunOptions::stop) and is raised (KeyboardInterrupt) once the run has ended.
-std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, mbdae::RunOptions options) {
+std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, PyRunOptions options) {
   const mbdae::Scene copy = scene;
   const bool main_thread = PyThread_get_thread_ident() == main_thread_id();
   if (!main_thread) {
     py::gil_scoped_release release;
-    return std::make_shared<mbdae::Result>(mbdae::run(copy, options));
+    return std::make_shared<mbdae::Result>(run_with_sinks(copy, options));
   }
   std::atomic<bool> stop{false};
   options.stop = &stop;
-  auto job = std::async(std::launch::async, [&] { return std::make_shared<mbdae::Result>(mbdae::run(copy, options)); });
+  auto job = std::async(std::launch::async, [&] { return std::make_shared<mbdae::Result>(run_with_sinks(copy, options)); });
   bool interrupted = false;
   while (true) {
     {
@@ -95,7 +112,8 @@ void bind_scene(py::module_& m) {
 }
 
 void bind_run(py::module_& m) {
-  py::class_<mbdae::RunOptions>(m, "RunOptions")
+  py::class_<mbdae::RunOptions>(m, "RunOptionsBase");
+  py::class_<PyRunOptions, mbdae::RunOptions>(m, "RunOptions")
       .def(py::init<>())
       .def_readwrite("rtol", &mbdae::RunOptions::rtol)
       .def_readwrite("atol", &mbdae::RunOptions::atol)
@@ -104,7 +122,7 @@ void bind_run(py::module_& m) {
       .def_readwrite("analysis", &mbdae::RunOptions::analysis)
       .def_readwrite("verbose", &mbdae::RunOptions::verbose)
       .def_readwrite("progress", &mbdae::RunOptions::progress)
-      .def_readwrite("out_dir", &mbdae::RunOptions::out_dir);
+      .def_readwrite("out_dir", &PyRunOptions::out_dir);
   py::class_<mbdae::Result, std::shared_ptr<mbdae::Result>>(m, "Result")
       .def_readonly("status", &mbdae::Result::status)
       .def_readonly("message", &mbdae::Result::message)

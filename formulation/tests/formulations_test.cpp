@@ -217,7 +217,7 @@ struct RunResult {
 };
 
 // Integrates `dae` from the model's initial configuration at rest; samples coordinate 0 and its
-// rate from the projected output, as run_scene does.
+// rate from the projected output, as run() does.
 template <class Dae>
 RunResult integrate_model(Dae& dae, const IdaOptions& o) {
   const System& sys = dae.system();

@@ -14,7 +14,7 @@ namespace {
 
 using namespace mbdae;
 
-// The row scaling run_scene uses: mean body mass / (1e-3 s)^2.
+// The row scaling run() uses: mean body mass / (1e-3 s)^2.
 double constraint_scale(const System& sys) {
   double m = 0;
   for (const auto& b : sys.bodies) m += b.mass;

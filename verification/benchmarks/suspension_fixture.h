@@ -25,7 +25,8 @@ inline SuspensionFixture suspension_at_equilibrium(const std::string& scene_file
   eo.hold = {f.sys.coordinate_index("q4"), f.sys.coordinate_index("q15")};
   eo.release = {f.sys.coordinate_index("q4")};
   eo.parameters = {{f.sys.force_index("suspension"), "free_length"}};
-  solve_equilibrium(f.sys, f.q, eo);
+  const EquilibriumResult r = solve_equilibrium(f.sys, f.q, eo);
+  f.sys = with_force_parameters(f.sys, eo.parameters, r.parameter_values);
   return f;
 }
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 #include "core/klu_solver.h"
 #include "formulation/analyses.h"
@@ -31,20 +31,19 @@ using json = nlohmann::ordered_json;
 const std::string kDir = std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/";
 
 struct Run {
-  RunOutcome out;
+  Result out;
   double cpu = 0;
   json stats;
 };
 
 Run run(const std::string& scene, double rtol, double atol, bool keep = true) {
   RunOptions o;
-  o.keep_rows = keep;
   o.verbose = false;
   o.progress = false;
   o.rtol = rtol;
   o.atol = atol;
   Run r;
-  r.out = run_scene(load_scene(kDir + scene), o);
+  r.out = mbdae::run(load_scene(kDir + scene), o);
   r.stats = r.out.summary["steps"].back()["statistics"];
   r.cpu = r.stats["cpu_seconds"].get<double>();
   return r;
@@ -54,8 +53,8 @@ double max_error(const Run& a, const Run& ref, const std::string& col) {
   const auto ca = std::find(a.out.columns.begin(), a.out.columns.end(), col) - a.out.columns.begin();
   const auto cr = std::find(ref.out.columns.begin(), ref.out.columns.end(), col) - ref.out.columns.begin();
   double m = 0;
-  for (size_t i = 0; i < std::min(a.out.rows.size(), ref.out.rows.size()); ++i)
-    m = std::max(m, std::fabs(a.out.rows[i][ca] - ref.out.rows[i][cr]));
+  for (size_t i = 0; i < std::min(a.out.rows(), ref.out.rows()); ++i)
+    m = std::max(m, std::fabs(a.out.data[ca][i] - ref.out.data[cr][i]));
   return m;
 }
 
@@ -89,7 +88,7 @@ Costs kernel_costs(const std::string& scene_file) {
   o.verbose = false;
   Scene statics = scene;
   statics.steps.pop_back();  // assembly and equilibria only
-  const RunOutcome pre = run_scene(statics, o);
+  const Result pre = mbdae::run(statics, o);
   System sys = build_system(scene.model);
   if (pre.summary.contains("spring_free_length"))
     sys.forces[sys.force_index("suspension")].free_length = pre.summary["spring_free_length"].get<double>();
@@ -98,7 +97,7 @@ Costs kernel_costs(const std::string& scene_file) {
   std::copy(pre.q.begin(), pre.q.end(), y.begin());
   dae.modes = initial_modes(sys, y.data(), 0.0);
   dae.consistent_initial_values(0.0, y, yp);
-  dae.output_accelerations = false;  // as run_scene: only for acceleration sensors
+  dae.output_accelerations = false;  // as run(): only for acceleration sensors
   for (const auto& s : sys.sensors)
     if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
   std::vector<double> values(dae.jacobian_pattern().nnz()), q, v, a, s(sys.sensors.size());

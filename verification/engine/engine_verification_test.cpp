@@ -1,5 +1,5 @@
 // End-to-end verification of the engine: scenes in verification/engine/scenes/ are loaded and run
-// as a user runs them (load_scene + run_scene, or the mbdae executable), and their output is
+// as a user runs them (load_scene + run, or the mbdae executable), and their output is
 // compared with references computed here from the scenes' data alone: closed-form solutions, the
 // complete elliptic integral by the arithmetic-geometric mean, energies from the initial joint
 // angles with Eigen's own rotations. No expected value is a recorded output of the engine.
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 #include "formulation/tests/pendulum_reference.h"
 
@@ -55,7 +55,6 @@ std::string scene_path(const std::string& name) {
 // Rows kept, nothing printed; `tight`: kTightRtol and kTightAtol instead of the scene's.
 mbdae::RunOptions test_options(bool tight) {
   mbdae::RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
   if (tight) {
@@ -65,8 +64,8 @@ mbdae::RunOptions test_options(bool tight) {
   return o;
 }
 
-mbdae::RunOutcome run(const std::string& name) {
-  return mbdae::run_scene(mbdae::load_scene(scene_path(name)), test_options(true));
+mbdae::Result run(const std::string& name) {
+  return mbdae::run(mbdae::load_scene(scene_path(name)), test_options(true));
 }
 
 // The text of a scene of verification/engine/scenes, to run modified with run_text().
@@ -78,24 +77,24 @@ std::string scene_text(const std::string& name) {
 }
 
 // A modified scene `text`, read as if it were the file `name` (for its relative paths).
-mbdae::RunOutcome run_text(const std::string& text, const std::string& name, bool tight) {
-  return mbdae::run_scene(mbdae::load_scene_text(text, scene_path(name)), test_options(tight));
+mbdae::Result run_text(const std::string& text, const std::string& name, bool tight) {
+  return mbdae::run(mbdae::load_scene_text(text, scene_path(name)), test_options(tight));
 }
 
-std::vector<double> series(const mbdae::RunOutcome& r, const std::string& name) {
+std::vector<double> series(const mbdae::Result& r, const std::string& name) {
   const auto it = std::find(r.columns.begin(), r.columns.end(), name);
   if (it == r.columns.end()) {
     ADD_FAILURE() << "no output column '" << name << "'";
-    return std::vector<double>(r.rows.size(), 0.0);
+    return std::vector<double>(r.rows(), 0.0);
   }
   const size_t c = static_cast<size_t>(it - r.columns.begin());
   std::vector<double> v;
-  for (const auto& row : r.rows) v.push_back(row[c]);
+  for (const std::vector<double>& row : r.row_major()) v.push_back(row[c]);
   return v;
 }
 
 // The summary entry of the run's kinematics or dynamics step.
-nlohmann::ordered_json integration_step(const mbdae::RunOutcome& r) {
+nlohmann::ordered_json integration_step(const mbdae::Result& r) {
   for (const auto& s : r.summary["steps"])
     if (s["type"] == "dynamics" || s["type"] == "kinematics") return s;
   ADD_FAILURE() << "no integration step in the summary";
@@ -103,7 +102,7 @@ nlohmann::ordered_json integration_step(const mbdae::RunOutcome& r) {
 }
 
 // Requirement d, with the measured values printed for the record.
-void expect_clean_integration(const mbdae::RunOutcome& r, const char* what) {
+void expect_clean_integration(const mbdae::Result& r, const char* what) {
   const auto step = integration_step(r);
   ASSERT_TRUE(step.contains("statistics"));
   const auto& st = step["statistics"];
@@ -115,11 +114,11 @@ void expect_clean_integration(const mbdae::RunOutcome& r, const char* what) {
   EXPECT_LT(drift, kMaxNormDrift) << what;
 }
 
-void expect_ran_to(const mbdae::RunOutcome& r, double t_end) {
+void expect_ran_to(const mbdae::Result& r, double t_end) {
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
   ASSERT_EQ(r.summary["status"], "ok");
-  ASSERT_FALSE(r.rows.empty());
-  EXPECT_DOUBLE_EQ(r.rows.back()[0], t_end);
+  ASSERT_FALSE((r.rows() == 0));
+  EXPECT_DOUBLE_EQ(r.data[0].back(), t_end);
 }
 
 // --- References ---------------------------------------------------------------------------------
@@ -184,7 +183,7 @@ CompoundPendulumReference compound_pendulum_reference() {
 }
 
 // Period from the downward crossings of theta - theta_eq.
-double measured_period(const mbdae::RunOutcome& r, double theta_eq) {
+double measured_period(const mbdae::Result& r, double theta_eq) {
   const auto t = series(r, "t"), theta = series(r, "theta"), rate = series(r, "theta_rate");
   std::vector<double> u(theta.size());
   for (size_t i = 0; i < u.size(); ++i) u[i] = theta[i] - theta_eq;
@@ -201,7 +200,7 @@ TEST(CompoundPendulum, PeriodMatchesEllipticIntegral) {
   const double i_hinge = ref.i_hinge, stiffness = ref.stiffness, theta_eq = ref.theta_eq;
   const double amplitude = ref.amplitude, period = ref.period;
 
-  const mbdae::RunOutcome r = run("compound_pendulum.yaml");
+  const mbdae::Result r = run("compound_pendulum.yaml");
   expect_ran_to(r, 10.5);
   const auto t = series(r, "t"), theta = series(r, "theta"), rate = series(r, "theta_rate");
   const auto kinetic = series(r, "kinetic"), potential = series(r, "potential");
@@ -249,7 +248,7 @@ TEST(CompoundPendulum, InitialVelocityGivesTheSameSwing) {
   ASSERT_NE(st, std::string::npos);
   std::snprintf(buf, sizeof buf, "{type: dynamics, initial_velocities: {theta: %.17g}, ", rate0);
   scene.replace(st, step.size(), buf);
-  const mbdae::RunOutcome r = run_text(scene, "compound_pendulum.yaml", true);
+  const mbdae::Result r = run_text(scene, "compound_pendulum.yaml", true);
   expect_ran_to(r, 10.5);
   const auto theta = series(r, "theta"), rate = series(r, "theta_rate");
   EXPECT_NEAR(theta[0], ref.theta_eq, 1e-12);
@@ -284,7 +283,7 @@ std::string free_slider_crank(const std::string& rates) {
 TEST(SliderCrank, InitialCrankRateSetsThePistonRate) {
   const std::string scene = free_slider_crank("phi: 6.283185307179586");
   ASSERT_FALSE(scene.empty());
-  const mbdae::RunOutcome r = run_text(scene, "slider_crank.yaml", false);
+  const mbdae::Result r = run_text(scene, "slider_crank.yaml", false);
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
   const double rr = 0.1, l = 0.35, w = 2 * kPi, phi = 0.6;
   const double sn = std::sin(phi), cs = std::cos(phi);
@@ -299,7 +298,7 @@ TEST(SliderCrank, InitialCrankRateSetsThePistonRate) {
 TEST(SliderCrank, InitialRatesBeyondTheDegreesOfFreedomAreRefused) {
   const std::string scene = free_slider_crank("phi: 6.283185307179586, x: 1.0");
   ASSERT_FALSE(scene.empty());
-  const mbdae::RunOutcome r = run_text(scene, "slider_crank.yaml", false);
+  const mbdae::Result r = run_text(scene, "slider_crank.yaml", false);
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.summary["status"], "inconsistent_initial_velocities") << r.summary.dump(2);
   const std::string message = r.summary.value("message", "");
@@ -309,7 +308,7 @@ TEST(SliderCrank, InitialRatesBeyondTheDegreesOfFreedomAreRefused) {
 // --- b. Spatial double pendulum ---------------------------------------------------------------
 
 TEST(SpatialDoublePendulum, EnergyIsConserved) {
-  const mbdae::RunOutcome r = run("double_pendulum.yaml");
+  const mbdae::Result r = run("double_pendulum.yaml");
   expect_ran_to(r, 10.0);
   const auto kinetic = series(r, "kinetic"), potential = series(r, "potential");
 
@@ -340,7 +339,7 @@ TEST(SpatialDoublePendulum, EnergyIsConserved) {
 // --- c. Slider-crank ----------------------------------------------------------------------------
 
 TEST(SliderCrank, PistonFollowsClosedForm) {
-  const mbdae::RunOutcome r = run("slider_crank.yaml");
+  const mbdae::Result r = run("slider_crank.yaml");
   const double w = 2 * kPi, crank = 0.1, rod = 0.35;
   expect_ran_to(r, 2.0);  // two revolutions
   const auto t = series(r, "t");
@@ -419,7 +418,7 @@ TEST(InvalidScene, UnknownField) {
 // --- f. Spring energy and a user force law ------------------------------------------------------
 
 TEST(SpringBody, EnergyIsConserved) {
-  const mbdae::RunOutcome r = run("spring_body.yaml");
+  const mbdae::Result r = run("spring_body.yaml");
   expect_ran_to(r, 3.0);
   const auto kinetic = series(r, "kinetic"), potential = series(r, "potential");
 
@@ -443,7 +442,7 @@ TEST(SpringBody, EnergyIsConserved) {
 }
 
 TEST(UserForceLaw, LinearBushingMatchesDampedOscillator) {
-  const mbdae::RunOutcome r = run("bushing.yaml");
+  const mbdae::Result r = run("bushing.yaml");
   expect_ran_to(r, 2.0);
   // bushing.yaml: m x'' + c x' + k x = m g per direction, from rest at x0.
   const double m = 2.0, k = 800, c = 4, g = 9.81;

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 
 namespace {
@@ -30,15 +30,14 @@ std::string pendulum(const std::string& mass = "2", const std::string& gravity =
          "  - {type: dynamics, t_end: 1, output_step: 0.1}\n";
 }
 
-mbdae::RunOutcome run_text(const std::string& text) {
+mbdae::Result run_text(const std::string& text) {
   mbdae::RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  return mbdae::run_scene(mbdae::load_scene_text(text, "scene.yaml"), o);
+  return mbdae::run(mbdae::load_scene_text(text, "scene.yaml"), o);
 }
 
-void expect_failure(const mbdae::RunOutcome& r, const std::string& status, const std::string& words) {
+void expect_failure(const mbdae::Result& r, const std::string& status, const std::string& words) {
   EXPECT_EQ(r.exit_code, 3) << r.summary.dump(2);
   EXPECT_EQ(r.summary["status"], status) << r.summary.dump(2);
   const std::string message = r.summary.value("message", "");
@@ -46,28 +45,28 @@ void expect_failure(const mbdae::RunOutcome& r, const std::string& status, const
 }
 
 TEST(NumericFailures, PendulumRunsCleanly) {  // the scene itself is fine
-  const mbdae::RunOutcome r = run_text(pendulum());
+  const mbdae::Result r = run_text(pendulum());
   EXPECT_EQ(r.exit_code, 0) << r.summary.dump(2);
-  EXPECT_EQ(r.rows.size(), 11u);
+  EXPECT_EQ(r.rows(), 11u);
 }
 
 // An expression sensor dividing by zero was written as inf in every row, with status ok.
 TEST(NumericFailures, InfiniteSensorStopsTheRun) {
-  const mbdae::RunOutcome r =
+  const mbdae::Result r =
       run_text(pendulum("2", "-9.81", "  - {name: inverse, type: expression, expression: \"1 / (theta - theta)\"}\n"));
   expect_failure(r, "non_finite", "sensor inverse is +inf at t = 0 ");
-  EXPECT_TRUE(r.rows.empty());  // no row with inf is written
+  EXPECT_EQ(r.rows(), 0u);  // no row with inf is written
 }
 
 // A sensor that becomes NaN later: asin((0.6 - theta) / 0.6) once theta < 0 (released at
 // 30 deg, the pendulum, of period 1.55 s, passes 0 at about 0.39 s): the rows before are kept,
 // the run stops at the first NaN sample (t = 0.4).
 TEST(NumericFailures, SensorTurningNaNStopsAtThatSample) {
-  const mbdae::RunOutcome r = run_text(
+  const mbdae::Result r = run_text(
       pendulum("2", "-9.81", "  - {name: odd, type: expression, expression: \"asin((0.6 - theta) / 0.6)\"}\n"));
   expect_failure(r, "non_finite", "sensor odd is NaN at t = 0.4 ");
-  ASSERT_EQ(r.rows.size(), 4u);  // t = 0 ... 0.3
-  for (const auto& row : r.rows) {
+  ASSERT_EQ(r.rows(), 4u);  // t = 0 ... 0.3
+  for (const auto& row : r.row_major()) {
     EXPECT_GT(row[1], 0.0);
     EXPECT_TRUE(std::isfinite(row[2]));
   }

@@ -1,5 +1,5 @@
 // IFToMM / MBSBenchmark problems A01, A02, A04, A05 (verification/iftomm/scenes/) run as a user
-// runs them (load_scene + run_scene) and compared with references that do not come from mbdae:
+// runs them (load_scene + run) and compared with references that do not come from mbdae:
 //   A01  the exact solution of the pendulum (Jacobi sn by the arithmetic-geometric mean);
 //   A02  M theta'' = -C cos(theta), the parallelogram's one-degree-of-freedom equation,
 //        integrated here by RK4 with tiny steps;
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 
 namespace {
@@ -40,27 +40,26 @@ mbdae::AnalysisStep& integration_step(mbdae::Scene& scene) {
 }
 
 // Runs a scene, optionally with another end time and output step (0: as in the scene).
-mbdae::RunOutcome run(const std::string& name, double t_end = 0, double output_step = 0) {
+mbdae::Result run(const std::string& name, double t_end = 0, double output_step = 0) {
   mbdae::Scene scene = mbdae::load_scene(scene_path(name));
   mbdae::AnalysisStep& step = integration_step(scene);
   if (t_end > 0) step.t_end = t_end;
   if (output_step > 0) step.output_step = output_step;
   mbdae::RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  return mbdae::run_scene(scene, o);
+  return mbdae::run(scene, o);
 }
 
-std::vector<double> series(const mbdae::RunOutcome& r, const std::string& name) {
+std::vector<double> series(const mbdae::Result& r, const std::string& name) {
   const auto it = std::find(r.columns.begin(), r.columns.end(), name);
   if (it == r.columns.end()) {
     ADD_FAILURE() << "no output column '" << name << "'";
-    return std::vector<double>(r.rows.size(), 0.0);
+    return std::vector<double>(r.rows(), 0.0);
   }
   const size_t c = static_cast<size_t>(it - r.columns.begin());
   std::vector<double> v;
-  for (const auto& row : r.rows) v.push_back(row[c]);
+  for (const std::vector<double>& row : r.row_major()) v.push_back(row[c]);
   return v;
 }
 
@@ -71,18 +70,18 @@ int sample_at(const std::vector<double>& t, double time) {
   return -1;
 }
 
-const nlohmann::ordered_json& statistics(const mbdae::RunOutcome& r) {
+const nlohmann::ordered_json& statistics(const mbdae::Result& r) {
   for (const auto& s : r.summary["steps"])
     if (s["type"] == "dynamics") return s["statistics"];
   static const nlohmann::ordered_json none;
   return none;
 }
 
-void expect_ran_to(const mbdae::RunOutcome& r, double t_end) {
+void expect_ran_to(const mbdae::Result& r, double t_end) {
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
   ASSERT_EQ(r.summary["status"], "ok");
-  ASSERT_FALSE(r.rows.empty());
-  EXPECT_NEAR(r.rows.back()[0], t_end, 1e-12);
+  ASSERT_FALSE((r.rows() == 0));
+  EXPECT_NEAR(r.data[0].back(), t_end, 1e-12);
   const auto& st = statistics(r);
   std::printf("  %ld steps, %ld residual evaluations, %ld KLU factorizations, cpu %.3f s\n",
               st["steps"].get<long>(), st["residual_evaluations"].get<long>(),
@@ -175,7 +174,7 @@ std::vector<double> crossings(const std::vector<double>& t, const std::vector<do
 }
 
 // Number of redundant equations reported, and how many of them name each kind of equation.
-int redundant_count(const mbdae::RunOutcome& r) {
+int redundant_count(const mbdae::Result& r) {
   return static_cast<int>(r.summary["redundant_constraints"]["redundant"].size());
 }
 
@@ -212,7 +211,7 @@ TEST(Reference, FourBarEquationMatchesTheResearchNotes) {
 
 TEST(A01SimplePendulum, MatchesExactSolution) {
   // The IFToMM version's 10 s, with the specification's 4000 output steps.
-  const mbdae::RunOutcome r = run("A01_simple_pendulum.yaml", 10.0, 10.0 / 4000);
+  const mbdae::Result r = run("A01_simple_pendulum.yaml", 10.0, 10.0 / 4000);
   expect_ran_to(r, 10.0);
   EXPECT_EQ(redundant_count(r), 0);
   const auto t = series(r, "t"), x = series(r, "x_P1"), y = series(r, "y_P1"), e = series(r, "energy");
@@ -247,7 +246,7 @@ constexpr double kA02Theta0 = kPi / 2, kA02VxB0 = 1.0, kA02VyB0 = 0.0;
 
 // The state at t = 0 (the scene's initial_velocities): B0's position and the specified
 // velocity, every crank at the same rate, and the rate mbdae reports as given.
-void check_four_bar_start(const mbdae::RunOutcome& r) {
+void check_four_bar_start(const mbdae::Result& r) {
   const auto t = series(r, "t"), x = series(r, "x_B0"), y = series(r, "y_B0");
   const auto vx = series(r, "vx_B0"), vy = series(r, "vy_B0");
   const auto w0 = series(r, "rate0"), w_mid = series(r, "rate_mid"), w_last = series(r, "rate_last");
@@ -275,7 +274,7 @@ void check_four_bar_start(const mbdae::RunOutcome& r) {
 // `bias`: the constraint violation the formulation allows by construction (0 for the exact
 // index-3 constraints; the penalty formulation's |lambda| / (p beta^2), formulation/index1_dae.h),
 // added to the bound that compares with exact kinematics (crank angle spread).
-void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tight, double bias = 0) {
+void check_four_bar(const mbdae::Result& r, int n, double t_end, double tight, double bias = 0) {
   EXPECT_EQ(redundant_count(r), 3 * n) << r.summary["redundant_constraints"].dump(1);
   EXPECT_EQ(r.summary["redundant_constraints"]["equations"].get<int>(), 5 * (3 * n + 1) + 2 * n + 1);
   EXPECT_EQ(r.summary["redundant_constraints"]["rank"].get<int>(), 5 * (3 * n + 1) + 2 * n + 1 - 3 * n);
@@ -307,7 +306,7 @@ void check_four_bar(const mbdae::RunOutcome& r, int n, double t_end, double tigh
 // up to 0.65 s are compared and required: close to the singular configuration, and on the last
 // step before the end time (see docs/iftomm-benchmarks.md, engine findings), IDA may fail with
 // IDA_CONV_FAIL, which is reported but not asserted here.
-mbdae::RunOutcome run_before_singular(const std::string& name) {
+mbdae::Result run_before_singular(const std::string& name) {
   // The index-3 integration (exact constraints), with the scenes' tolerances and the Newton
   // convergence coefficient it was tuned with; the scenes themselves use the penalty formulation.
   mbdae::Scene scene = mbdae::load_scene(scene_path(name));
@@ -322,35 +321,34 @@ mbdae::RunOutcome run_before_singular(const std::string& name) {
   step.rtol = 1e-11;
   step.atol = 1e-14;
   mbdae::RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  const mbdae::RunOutcome r = mbdae::run_scene(scene, o);
+  const mbdae::Result r = mbdae::run(scene, o);
   if (r.exit_code != 0)
     std::printf("  note: the run to 0.70 s stopped: %s\n", r.summary.value("message", std::string()).c_str());
   EXPECT_TRUE(r.exit_code == 0 || r.summary["status"] == "integration_failed");
-  EXPECT_FALSE(r.rows.empty());
+  EXPECT_FALSE((r.rows() == 0));
   return r;
 }
 
 // The samples of r up to t_max.
-mbdae::RunOutcome up_to(mbdae::RunOutcome r, double t_max) {
-  while (!r.rows.empty() && r.rows.back()[0] > t_max + 1e-9) r.rows.pop_back();
+mbdae::Result up_to(mbdae::Result r, double t_max) {
+  while (!(r.rows() == 0) && r.data[0].back() > t_max + 1e-9) for (auto& col : r.data) col.pop_back();
   return r;
 }
 
 TEST(A02NFourBar, N40UpToTheFirstSingularConfiguration) {
   const double t_end = 0.65;
   ASSERT_LT(t_end, kA02FirstSingular);
-  const mbdae::RunOutcome r = up_to(run_before_singular("A02_n_four_bar_N40.yaml"), t_end);
-  ASSERT_NEAR(r.rows.back()[0], t_end, 1e-9);
+  const mbdae::Result r = up_to(run_before_singular("A02_n_four_bar_N40.yaml"), t_end);
+  ASSERT_NEAR(r.data[0].back(), t_end, 1e-9);
   check_four_bar(r, 40, t_end, 1e-6);
 }
 
 TEST(A02NFourBar, N2UpToTheFirstSingularConfiguration) {
   const double t_end = 0.65;  // N = 2: first singular configuration at 0.714 s
-  const mbdae::RunOutcome r = up_to(run_before_singular("A02_n_four_bar_N2.yaml"), t_end);
-  ASSERT_NEAR(r.rows.back()[0], t_end, 1e-9);
+  const mbdae::Result r = up_to(run_before_singular("A02_n_four_bar_N2.yaml"), t_end);
+  ASSERT_NEAR(r.data[0].back(), t_end, 1e-9);
   check_four_bar(r, 2, t_end, 1e-6);
 }
 
@@ -361,7 +359,7 @@ TEST(A02NFourBar, N2UpToTheFirstSingularConfiguration) {
 // index1 fail with IDA_CONV_FAIL at the first crossing (docs/iftomm-benchmarks.md).
 TEST(A02NFourBar, N40PassesSingularConfigurations) {
   const double t_end = 5.0;
-  const mbdae::RunOutcome r = run("A02_n_four_bar_N40.yaml", t_end);
+  const mbdae::Result r = run("A02_n_four_bar_N40.yaml", t_end);
   expect_ran_to(r, t_end);
   // Horizontal configurations passed: sign changes of y_B0 = sin(theta), against the reference.
   const auto t = series(r, "t"), y = series(r, "y_B0");
@@ -391,17 +389,16 @@ TEST(A02NFourBar, N40PassesSingularConfigurations) {
 // there; otherwise the last step goes past it and the end is interpolated.
 TEST(EngineFindings, LastStepToTheEndTime) {
   mbdae::RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  const mbdae::RunOutcome r = mbdae::run_scene(mbdae::load_scene(scene_path("repro_end_step_conv_fail.yaml")), o);
+  const mbdae::Result r = mbdae::run(mbdae::load_scene(scene_path("repro_end_step_conv_fail.yaml")), o);
   expect_ran_to(r, 0.48);
 }
 
 // --- A04 Bricard mechanism ----------------------------------------------------------------------
 
 TEST(A04Bricard, OneRedundantEquationAndExactKinematics) {
-  const mbdae::RunOutcome r = run("A04_bricard.yaml");
+  const mbdae::Result r = run("A04_bricard.yaml");
   expect_ran_to(r, 10.0);
   // 5 bodies: 35 coordinates; 6 revolutes (30) + 5 Euler norms; rank 34.
   const auto& rc = r.summary["redundant_constraints"];
@@ -476,7 +473,7 @@ TEST(A04Bricard, OneRedundantEquationAndExactKinematics) {
 // --- A05 stiff flyball governor -----------------------------------------------------------------
 
 TEST(A05StiffFlyballGovernor, SleeveMotionAndAngularMomentum) {
-  const mbdae::RunOutcome r = run("A05_stiff_flyball_governor.yaml");
+  const mbdae::Result r = run("A05_stiff_flyball_governor.yaml");
   expect_ran_to(r, 10.0);
   EXPECT_EQ(redundant_count(r), 0);
   const auto t = series(r, "t"), s = series(r, "s"), s_rate = series(r, "s_rate"), omega = series(r, "omega");

@@ -14,7 +14,7 @@
 //
 // Timings (CPU time of the process, clock_gettime(CLOCK_PROCESS_CPUTIME_ID)):
 //   setup      build_system, the consistent projection of the guess and the redundancy analysis
-//              (SPQR rank-revealing QR of Phi_q^T), each timed separately, as run_scene does it;
+//              (SPQR rank-revealing QR of Phi_q^T), each timed separately, as run() does it;
 //   residual   each DaeProblem::residual call, by a DaeProblem wrapper around Index3Dae;
 //   jacobian   each DaeProblem::jacobian call (assembly of dF/dy + cj dF/dy'), the same way;
 //   KLU        the factorizations happen inside IDA's linear solver (core/klu_linear_solver.cpp,
@@ -185,7 +185,7 @@ Result run_one(int n) {
   res.build_s = cpu_now() - c0;
   res.bodies = sys.num_bodies();
 
-  // As run_scene: regularized projection of the guess, then redundancy analysis and removal.
+  // As run(): regularized projection of the guess, then redundancy analysis and removal.
   std::vector<double> q = sys.q0;
   c0 = cpu_now();
   {
@@ -194,7 +194,8 @@ Result run_one(int n) {
   }
   res.project_s = cpu_now() - c0;
   c0 = cpu_now();
-  const RedundancyReport rr = find_redundant_constraints(sys, q.data(), 0.0, true);
+  const RedundancyReport rr = find_redundant_constraints(sys, q.data(), 0.0);
+  sys = without_redundant_constraints(sys, rr);
   res.qr_s = cpu_now() - c0;
   res.redundant = static_cast<long>(rr.redundant.size());
   res.equations = sys.num_constraint_rows();
@@ -202,7 +203,7 @@ Result run_one(int n) {
   // Initial velocities as a scene's initial_velocities gives them (formulation/initial_velocities.h):
   // the rate theta' = -1 rad/s of crank 0, the rest from the constraints (timed with the
   // consistent start). Index3Dae's velocity projection then makes them consistent to rounding.
-  Index3Dae dae(sys, 1.0 / (1e-3 * 1e-3));  // run_scene's automatic scale: mean mass / (1e-3 s)^2
+  Index3Dae dae(sys, 1.0 / (1e-3 * 1e-3));  // run()'s automatic scale: mean mass / (1e-3 s)^2
   dae.modes = initial_modes(sys, q.data(), 0.0);
   res.unknowns = dae.size();
   res.jac_nnz = dae.jacobian_pattern().nnz();

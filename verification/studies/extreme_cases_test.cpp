@@ -1,5 +1,5 @@
 // Short versions of the stiff and extreme cases (verification/studies/extreme/*.yaml, documented
-// in docs/extreme-cases.md): the fast scenes run through run_scene, each asserting its documented
+// in docs/extreme-cases.md): the fast scenes run through run(), each asserting its documented
 // outcome. Bounds are the measured values (docs/extreme-cases.md) with a margin of about 3 to 50.
 // A test here failing means the documented outcome changed: update the page (run_extreme.sh)
 // together with the test.
@@ -15,7 +15,7 @@
 
 #include <Eigen/SVD>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 #include "verification/reference/suspension_reference.h"
 
@@ -32,23 +32,22 @@ std::string spec_scene(const std::string& name) {
   return std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/" + name;
 }
 
-RunOutcome run(const std::string& path, double rtol = 0, double atol = 0) {
+Result run(const std::string& path, double rtol = 0, double atol = 0) {
   RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
   o.rtol = rtol;
   o.atol = atol;
-  return run_scene(load_scene(path), o);
+  return mbdae::run(load_scene(path), o);
 }
 
-int column(const RunOutcome& r, const std::string& name) {
+int column(const Result& r, const std::string& name) {
   auto it = std::find(r.columns.begin(), r.columns.end(), name);
   EXPECT_NE(it, r.columns.end()) << name;
   return it == r.columns.end() ? 0 : static_cast<int>(it - r.columns.begin());
 }
 
-const json& step_of(const RunOutcome& r, const std::string& type) {
+const json& step_of(const Result& r, const std::string& type) {
   for (const auto& s : r.summary["steps"])
     if (s["type"] == type) return s;
   static json none = json::object();
@@ -57,15 +56,15 @@ const json& step_of(const RunOutcome& r, const std::string& type) {
 }
 
 // Max |a - b| of a column over the output samples both runs have (matched by time).
-double max_difference(const RunOutcome& a, const RunOutcome& b, const std::string& name) {
+double max_difference(const Result& a, const Result& b, const std::string& name) {
   const int ca = column(a, name), cb = column(b, name);
   size_t i = 0, j = 0, n = 0;
   double m = 0;
-  while (i < a.rows.size() && j < b.rows.size()) {
-    const double ta = a.rows[i][0], tb = b.rows[j][0];
+  while (i < a.rows() && j < b.rows()) {
+    const double ta = a.data[0][i], tb = b.data[0][j];
     if (ta < tb - 1e-9) { ++i; continue; }
     if (tb < ta - 1e-9) { ++j; continue; }
-    m = std::max(m, std::fabs(a.rows[i][ca] - b.rows[j][cb]));
+    m = std::max(m, std::fabs(a.data[ca][i] - b.data[cb][j]));
     ++n, ++i, ++j;
   }
   EXPECT_GT(n, 0u) << name;
@@ -78,8 +77,8 @@ std::string sci(double x) {
   return buf;
 }
 
-bool all_finite(const RunOutcome& r) {
-  for (const auto& row : r.rows)
+bool all_finite(const Result& r) {
+  for (const std::vector<double>& row : r.row_major())
     for (double x : row)
       if (!std::isfinite(x)) return false;
   return true;
@@ -91,10 +90,10 @@ bool all_finite(const RunOutcome& r) {
 // the wheel lands at visibly different times), constraints still held to 5e-3 at the steps
 // (measured 3.6e-4; 4e-5 with the build of a001003).
 TEST(ExtremeCases, LooseToleranceRunsWithItsMeasuredError) {
-  const RunOutcome r = run(extreme("step_loose_tolerance.yaml"));
+  const Result r = run(extreme("step_loose_tolerance.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(1);
   EXPECT_EQ(r.summary["status"], "ok");
-  const RunOutcome tight = run(extreme("step_loose_tolerance.yaml"), 1e-12, 1e-16);
+  const Result tight = run(extreme("step_loose_tolerance.yaml"), 1e-12, 1e-16);
   ASSERT_EQ(tight.exit_code, 0) << tight.summary["message"];
   const double e = max_difference(r, tight, "wheel_z");
   RecordProperty("wheel_z_error", sci(e));
@@ -106,9 +105,9 @@ TEST(ExtremeCases, LooseToleranceRunsWithItsMeasuredError) {
 // rtol 1e-12, atol 1e-18 (below rounding; mbdae floors the weights): runs to the end and agrees
 // with rtol 1e-11 to 1e-8 m (measured 2e-10 m).
 TEST(ExtremeCases, TightToleranceRunsToTheEnd) {
-  const RunOutcome r = run(extreme("step_tight_tolerance.yaml"));
+  const Result r = run(extreme("step_tight_tolerance.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
-  const RunOutcome other = run(extreme("step_tight_tolerance.yaml"), 1e-11, 1e-17);
+  const Result other = run(extreme("step_tight_tolerance.yaml"), 1e-11, 1e-17);
   ASSERT_EQ(other.exit_code, 0) << other.summary["message"];
   const double e = max_difference(r, other, "wheel_z");
   RecordProperty("wheel_z_difference_to_rtol_1e-11", sci(e));
@@ -124,19 +123,19 @@ TEST(ExtremeCases, TightToleranceRunsToTheEnd) {
 // then hops on the stiff tyre: many more contact events (measured 105, spec scene 9). wheel_z
 // within 5e-5 m of a tighter run (measured 1.2e-5 m).
 TEST(ExtremeCases, StiffTyreX100RunsAccurately) {
-  const RunOutcome r = run(extreme("tyre_stiffness_x100.yaml"));
+  const Result r = run(extreme("tyre_stiffness_x100.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
   const json& d = step_of(r, "dynamics");
   EXPECT_GE(d["event_times"].size(), 50u);
   const int z = column(r, "wheel_z"), az = column(r, "wheel_az");
-  EXPECT_NEAR(r.rows.front()[z], 0.2997, 1e-3);  // 22 mm above the spec scene's 0.278 m
-  for (const auto& row : r.rows) {
+  EXPECT_NEAR(r.data[z].front(), 0.2997, 1e-3);  // 22 mm above the spec scene's 0.278 m
+  for (const std::vector<double>& row : r.row_major()) {
     if (row[0] > 0.2005 && row[0] < 0.205) {
       EXPECT_LT(row[az], -150.0) << row[0];
     }
   }
-  EXPECT_NEAR(r.rows.back()[z], 0.2, 1e-3);  // rests on the lowered ground, 0.22 mm deflection
-  const RunOutcome tight = run(extreme("tyre_stiffness_x100.yaml"), 1e-10, 1e-16);
+  EXPECT_NEAR(r.data[z].back(), 0.2, 1e-3);  // rests on the lowered ground, 0.22 mm deflection
+  const Result tight = run(extreme("tyre_stiffness_x100.yaml"), 1e-10, 1e-16);
   ASSERT_EQ(tight.exit_code, 0) << tight.summary["message"];
   const double e = max_difference(r, tight, "wheel_z");
   RecordProperty("wheel_z_error", sci(e));
@@ -148,18 +147,18 @@ TEST(ExtremeCases, StiffTyreX100RunsAccurately) {
 // 1.0e-5 m), and the wheel
 // still moves at the end (over [1, 1.5] s it travels more than with the spec's damping).
 TEST(ExtremeCases, ZeroDampingRunsAccurately) {
-  const RunOutcome r = run(extreme("damping_zero.yaml"));
+  const Result r = run(extreme("damping_zero.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
-  const RunOutcome tight = run(extreme("damping_zero.yaml"), 1e-10, 1e-15);
+  const Result tight = run(extreme("damping_zero.yaml"), 1e-10, 1e-15);
   ASSERT_EQ(tight.exit_code, 0) << tight.summary["message"];
   const double e = max_difference(r, tight, "wheel_z");
   RecordProperty("wheel_z_error", sci(e));
   EXPECT_LT(e, 1e-4);
-  const RunOutcome damped = run(spec_scene("dynamics_step.yaml"));
+  const Result damped = run(spec_scene("dynamics_step.yaml"));
   ASSERT_EQ(damped.exit_code, 0);
-  auto late_range = [](const RunOutcome& o, int c) {
+  auto late_range = [](const Result& o, int c) {
     double lo = 1e9, hi = -1e9;
-    for (const auto& row : o.rows)
+    for (const std::vector<double>& row : o.row_major())
       if (row[0] >= 1.0) lo = std::min(lo, row[c]), hi = std::max(hi, row[c]);
     return hi - lo;
   };
@@ -173,25 +172,25 @@ TEST(ExtremeCases, ZeroDampingRunsAccurately) {
 struct ReferenceComparison {
   double worst = 0, sigma_min_end = 1e9, q4_unwrapped = 0;
 };
-ReferenceComparison compare_with_reference(const RunOutcome& r) {
+ReferenceComparison compare_with_reference(const Result& r) {
   ReferenceComparison c;
   const int cq = column(r, "q4"), cx = column(r, "wheel_x"), cy = column(r, "wheel_y"), cz = column(r, "wheel_z");
   const ref::SuspensionData data = ref::spec_data();
   ref::CarrierPose pose = ref::design_pose(data);
   double q4_prev = data.q4_design;
   c.q4_unwrapped = data.q4_design;
-  for (size_t i = 0; i < r.rows.size(); i += 25) {
+  for (size_t i = 0; i < r.rows(); i += 25) {
     // The q4 sensor is an angle in (-pi, pi]: unwrap it (the drive passes +pi).
-    c.q4_unwrapped += std::remainder(r.rows[i][cq] - c.q4_unwrapped, 2 * M_PI);
+    c.q4_unwrapped += std::remainder(r.data[cq][i] - c.q4_unwrapped, 2 * M_PI);
     ref::NewtonReport rep;
     pose = ref::continue_pose(data, pose, q4_prev, c.q4_unwrapped, &rep, 0.01);
     EXPECT_TRUE(rep.converged) << "reference continuation failed at q4 = " << c.q4_unwrapped;
     if (!rep.converged) return c;
     q4_prev = c.q4_unwrapped;
     const ref::WheelOutputs w = ref::wheel_outputs(data, pose);
-    c.worst = std::max({c.worst, std::fabs(r.rows[i][cx] - w.centre.x()), std::fabs(r.rows[i][cy] - w.centre.y()),
-                        std::fabs(r.rows[i][cz] - w.centre.z())});
-    if (std::fabs(r.rows[i][0] - 1.0) < 1e-9 || i + 25 >= r.rows.size())
+    c.worst = std::max({c.worst, std::fabs(r.data[cx][i] - w.centre.x()), std::fabs(r.data[cy][i] - w.centre.y()),
+                        std::fabs(r.data[cz][i] - w.centre.z())});
+    if (std::fabs(r.data[0][i] - 1.0) < 1e-9 || i + 25 >= r.rows())
       c.sigma_min_end = std::min(c.sigma_min_end, rep.min_singular_value);
   }
   return c;
@@ -202,7 +201,7 @@ ReferenceComparison compare_with_reference(const RunOutcome& r) {
 // reference geometry (carrier-pose formulation, verification/reference) to 1e-9 (measured
 // 1.9e-11 m; the reference's smallest singular value falls from 0.145 at q4_0 to 0.004 there).
 TEST(ExtremeCases, KinematicDriveToTheEndsOfTheTravelMatchesTheReference) {
-  const RunOutcome r = run(extreme("kinematics_travel_ends.yaml"));
+  const Result r = run(extreme("kinematics_travel_ends.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
   const ReferenceComparison c = compare_with_reference(r);
   RecordProperty("max_wheel_centre_difference", sci(c.worst));
@@ -221,7 +220,7 @@ TEST(ExtremeCases, KinematicDriveToTheEndsOfTheTravelMatchesTheReference) {
 // singularity). Runs to the end, lands on the kink without error-test failures around it, and
 // is closer to the reference than the scene's rtol 1e-11 run.
 TEST(ExtremeCases, KinematicDriveToTheEndsRunsAtRtol1e13) {
-  const RunOutcome r = run(extreme("kinematics_travel_ends.yaml"), 1e-13, 1e-13);
+  const Result r = run(extreme("kinematics_travel_ends.yaml"), 1e-13, 1e-13);
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
   const json& k = step_of(r, "kinematics");
   ASSERT_EQ(k["breakpoint_times"].size(), 1u);
@@ -277,14 +276,14 @@ ReferenceFold reference_fold() {
 // names rods 1 and 3 as carrying the singular combination and rods 4 and 5 as the least involved;
 // the message must name rod 1's and rod 3's joints and none of rod 4's and rod 5's.
 TEST(ExtremeCases, KinematicDrivePastTheTravelNamesTheSingularConfiguration) {
-  const RunOutcome r = run(extreme("kinematics_past_travel.yaml"));
+  const Result r = run(extreme("kinematics_past_travel.yaml"));
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.summary["status"], "integration_failed");
   const std::string msg = r.summary.value("message", "");
   const json& k = step_of(r, "kinematics");
   const double t_fail = k["t_reached"].get<double>();
   EXPECT_LT(k["statistics"]["max_position_violation_steps"].get<double>(), 1e-9);
-  ASSERT_FALSE(r.rows.empty());
+  ASSERT_FALSE((r.rows() == 0));
   EXPECT_TRUE(all_finite(r));
 
   // The last configuration: q4 follows the drive's formula up to the failure, and the fold of the
@@ -346,12 +345,12 @@ TEST(ExtremeCases, KinematicDrivePastTheTravelNamesTheSingularConfiguration) {
 // Every joint angle 10 degrees off (above or below): the assembly converges to the design
 // configuration and the ground-step response is that of the spec's scene.
 TEST(ExtremeCases, RoughGuessTenDegreesOffConvergesToTheDesignConfiguration) {
-  const RunOutcome spec = run(spec_scene("dynamics_step.yaml"));
+  const Result spec = run(spec_scene("dynamics_step.yaml"));
   ASSERT_EQ(spec.exit_code, 0);
   const json& sa = step_of(spec, "assembly");
   for (const char* name : {"rough_guess_10deg_plus.yaml", "rough_guess_10deg_minus.yaml"}) {
     SCOPED_TRACE(name);
-    const RunOutcome r = run(extreme(name));
+    const Result r = run(extreme(name));
     ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
     const json& a = step_of(r, "assembly");
     EXPECT_TRUE(a["assembly_mode"]["same_as_guess"].get<bool>()) << a["assembly_mode"].dump();
@@ -380,11 +379,11 @@ TEST(ExtremeCases, RoughGuessTenDegreesOffConvergesToTheDesignConfiguration) {
 // scene's guesses and the converged coordinates. With mode_check: fail the same scene stops
 // with exit code 3.
 TEST(ExtremeCases, RoughGuessSixtyDegreesOffWarnsOfAnotherAssemblyMode) {
-  const RunOutcome spec = run(spec_scene("dynamics_step.yaml"));
+  const Result spec = run(spec_scene("dynamics_step.yaml"));
   ASSERT_EQ(spec.exit_code, 0);
   const json& sa = step_of(spec, "assembly");
   const std::string path = extreme("rough_guess_60deg_plus.yaml");
-  const RunOutcome r = run(path);
+  const Result r = run(path);
   ASSERT_EQ(r.exit_code, 0) << r.summary["message"];
   const json& a = step_of(r, "assembly");
   EXPECT_LE(a["max_constraint_violation"].get<double>(), 1e-12);
@@ -422,7 +421,7 @@ TEST(ExtremeCases, RoughGuessSixtyDegreesOffWarnsOfAnotherAssemblyMode) {
   RunOptions o;
   o.verbose = false;
   o.progress = false;
-  const RunOutcome failed = run_scene(load_scene_text(text, path), o);
+  const Result failed = mbdae::run(load_scene_text(text, path), o);
   EXPECT_EQ(failed.exit_code, 3);
   EXPECT_EQ(failed.summary["status"], "assembly_mode_changed");
   const std::string same = warning.substr(0, warning.find("; check the guess"));
@@ -431,7 +430,7 @@ TEST(ExtremeCases, RoughGuessSixtyDegreesOffWarnsOfAnotherAssemblyMode) {
 
 // 90 degrees below: the assembly does not converge and says so (exit 3, most violated equations).
 TEST(ExtremeCases, RoughGuessNinetyDegreesOffFailsClearly) {
-  const RunOutcome r = run(extreme("rough_guess_90deg_minus.yaml"));
+  const Result r = run(extreme("rough_guess_90deg_minus.yaml"));
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(r.summary["status"], "assembly_failed");
   const std::string msg = r.summary.value("message", "");

@@ -44,7 +44,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 #include "core/errors.h"
 
@@ -217,7 +217,7 @@ struct Run {
   double err[3] = {NAN, NAN, NAN};
   long compared = 0;
   double viol_pos = NAN, viol_vel = NAN, norm_drift = NAN;
-  mbdae::RunOutcome outcome;
+  mbdae::Result outcome;
 };
 
 double median(std::vector<double> v) {
@@ -246,15 +246,14 @@ Run run(const mbdae::Scene& scene, const std::string& formulation, double tol, d
   std::vector<double> cpus, walls;
   for (int k = 0; k < repeat; ++k) {
     mbdae::RunOptions opt;
-    opt.keep_rows = k == 0;
     opt.verbose = false;
     opt.progress = false;
     opt.rtol = rtol;
     opt.atol = atol;
     const auto w0 = std::chrono::steady_clock::now();
-    mbdae::RunOutcome out;
+    mbdae::Result out;
     try {
-      out = mbdae::run_scene(scene, opt);
+      out = mbdae::run(scene, opt);
     } catch (const std::exception& e) {
       r.exit_code = 3;
       r.status = "exception";
@@ -296,7 +295,7 @@ Run run(const mbdae::Scene& scene, const std::string& formulation, double tol, d
       opt.rtol = rtol;
       opt.atol = atol;
       try {
-        const mbdae::RunOutcome out = mbdae::run_scene(bare, opt);
+        const mbdae::Result out = mbdae::run(bare, opt);
         const json* step = integration_step(out.summary);
         if (out.exit_code != 0) break;
         bare_cpus.push_back(stat(step, "cpu_seconds"));
@@ -313,13 +312,13 @@ Run run(const mbdae::Scene& scene, const std::string& formulation, double tol, d
   return r;
 }
 
-int column(const mbdae::RunOutcome& r, const std::string& name) {
+int column(const mbdae::Result& r, const std::string& name) {
   auto it = std::find(r.columns.begin(), r.columns.end(), name);
   return it == r.columns.end() ? -1 : static_cast<int>(it - r.columns.begin());
 }
 
 // Max |a - b| of each signal over the output samples both runs have (matched by time).
-void compare(const mbdae::RunOutcome& a, const mbdae::RunOutcome& b, double err[3], long& compared) {
+void compare(const mbdae::Result& a, const mbdae::Result& b, double err[3], long& compared) {
   compared = 0;
   int ca[3], cb[3];
   for (int s = 0; s < 3; ++s) {
@@ -328,14 +327,14 @@ void compare(const mbdae::RunOutcome& a, const mbdae::RunOutcome& b, double err[
     err[s] = (ca[s] < 0 || cb[s] < 0) ? NAN : 0.0;
   }
   size_t i = 0, j = 0;
-  while (i < a.rows.size() && j < b.rows.size()) {
-    const double ta = a.rows[i][0], tb = b.rows[j][0];
+  while (i < a.rows() && j < b.rows()) {
+    const double ta = a.data[0][i], tb = b.data[0][j];
     const double eps = 1e-9 * std::max(1.0, std::fabs(ta));
     if (ta < tb - eps) { ++i; continue; }
     if (tb < ta - eps) { ++j; continue; }
     for (int s = 0; s < 3; ++s)
       if (ca[s] >= 0 && cb[s] >= 0) {
-        const double d = std::fabs(a.rows[i][ca[s]] - b.rows[j][cb[s]]);
+        const double d = std::fabs(a.data[ca[s]][i] - b.data[cb[s]][j]);
         err[s] = std::isfinite(d) ? std::max(err[s], d) : NAN;
         if (!std::isfinite(d)) ca[s] = -1;
       }
@@ -426,7 +425,7 @@ int main(int argc, char** argv) {
     const int c = column(ref.outcome, kSignals[s]);
     if (c < 0) continue;
     double lo = 1e300, hi = -1e300;
-    for (const auto& row : ref.outcome.rows) {
+    for (const std::vector<double>& row : ref.outcome.row_major()) {
       lo = std::min(lo, row[c]);
       hi = std::max(hi, row[c]);
     }
@@ -446,7 +445,7 @@ int main(int argc, char** argv) {
                   g(r.err[1], 3).c_str(), g(r.err[2], 3).c_str(), g(r.viol_pos, 3).c_str(), g(r.viol_vel, 3).c_str(),
                   r.status.c_str(), r.exit_code ? (" at t = " + g(r.t_reached, 6) + ": " + r.message).c_str() : "");
       std::fflush(stdout);
-      r.outcome = mbdae::RunOutcome{};  // rows no longer needed
+      r.outcome = mbdae::Result{};  // rows no longer needed
       runs.push_back(std::move(r));
     }
   }

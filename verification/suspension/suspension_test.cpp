@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cases/run_scene.h"
+#include "cases/mbdae.h"
 #include "cases/scene.h"
 #include "core/errors.h"
 #include "verification/reference/suspension_reference.h"
@@ -21,26 +21,25 @@ std::string scene_path(const std::string& name) {
   return std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/" + name;
 }
 
-RunOutcome run(const std::string& name, double rtol = 0, double atol = 0, const std::string& formulation = "") {
+Result run(const std::string& name, double rtol = 0, double atol = 0, const std::string& formulation = "") {
   RunOptions o;
   o.formulation = formulation;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
   o.rtol = rtol;
   o.atol = atol;
-  RunOutcome r = run_scene(load_scene(scene_path(name)), o);
+  Result r = mbdae::run(load_scene(scene_path(name)), o);
   EXPECT_EQ(r.exit_code, 0) << r.summary.dump(2);
   return r;
 }
 
-int column(const RunOutcome& r, const std::string& name) {
+int column(const Result& r, const std::string& name) {
   auto it = std::find(r.columns.begin(), r.columns.end(), name);
   EXPECT_NE(it, r.columns.end()) << name;
   return static_cast<int>(it - r.columns.begin());
 }
 
-const json& step_of(const RunOutcome& r, const std::string& type, int nth = 0) {
+const json& step_of(const Result& r, const std::string& type, int nth = 0) {
   for (const auto& s : r.summary["steps"])
     if (s["type"] == type && nth-- == 0) return s;
   static json none;
@@ -49,7 +48,7 @@ const json& step_of(const RunOutcome& r, const std::string& type, int nth = 0) {
 }
 
 TEST(Suspension, AssemblyFromTheSpecGuessMatchesTheReference) {
-  const RunOutcome r = run("equilibrium.yaml");
+  const Result r = run("equilibrium.yaml");
   const json& a = step_of(r, "assembly");
   EXPECT_LE(a["max_constraint_violation"].get<double>(), 1e-12);
   const json& s = a["sensors"];
@@ -75,7 +74,7 @@ TEST(Suspension, AssemblyFromTheSpecGuessMatchesTheReference) {
 }
 
 TEST(Suspension, KinematicSweepMatchesTheReferenceGeometry) {
-  const RunOutcome r = run("kinematics.yaml");
+  const Result r = run("kinematics.yaml");
   const json& k = step_of(r, "kinematics");
   EXPECT_LT(k["statistics"]["max_position_violation_steps"].get<double>(), 1e-10);
   EXPECT_EQ(r.columns, (std::vector<std::string>{"t", "q4", "wheel_x", "wheel_y", "wheel_z", "camber", "toe"}));
@@ -84,8 +83,8 @@ TEST(Suspension, KinematicSweepMatchesTheReferenceGeometry) {
   double q4_prev = data.q4_design;
   // 46 samples over both stages (every 0.05 s of the 2 s drive), reached by continuation.
   int checked = 0;
-  for (size_t i = 0; i < r.rows.size(); i += 50) {
-    const std::vector<double>& row = r.rows[i];
+  for (size_t i = 0; i < r.rows(); i += 50) {
+    const std::vector<double> row = r.row(i);
     const double q4 = row[column(r, "q4")];
     pose = ref::continue_pose(data, pose, q4_prev, q4);
     q4_prev = q4;
@@ -100,17 +99,17 @@ TEST(Suspension, KinematicSweepMatchesTheReferenceGeometry) {
   EXPECT_GE(checked, 20);
   // The sweep covers +-0.20 m of wheel travel around the design height.
   double zmin = 1e9, zmax = -1e9;
-  for (const auto& row : r.rows) {
+  for (const std::vector<double>& row : r.row_major()) {
     zmin = std::min(zmin, row[column(r, "wheel_z")]);
     zmax = std::max(zmax, row[column(r, "wheel_z")]);
   }
-  const double z0 = r.rows.front()[column(r, "wheel_z")];
+  const double z0 = r.data[column(r, "wheel_z")].front();
   EXPECT_LT(zmin, z0 - 0.20);
   EXPECT_GT(zmax, z0 + 0.20);
 }
 
 TEST(Suspension, SpringFreeLengthMatchesVirtualWork) {
-  const RunOutcome r = run("equilibrium.yaml");
+  const Result r = run("equilibrium.yaml");
   const ref::SuspensionData data = ref::spec_data();
   const double z0_ref = ref::spring_free_length(data, data.q4_design);
   EXPECT_NEAR(r.summary["spring_free_length"].get<double>(), z0_ref, 1e-9);
@@ -126,7 +125,7 @@ TEST(Suspension, ChassisFreeEquilibriumMatchesTheReference) {
   scene.steps.pop_back();
   RunOptions o;
   o.verbose = false;
-  const RunOutcome r = run_scene(scene, o);
+  const Result r = mbdae::run(scene, o);
   ASSERT_EQ(r.exit_code, 0);
   const ref::SuspensionData data = ref::spec_data();
   const double z0 = ref::spring_free_length(data, data.q4_design);
@@ -138,7 +137,7 @@ TEST(Suspension, ChassisFreeEquilibriumMatchesTheReference) {
 }
 
 TEST(Suspension, GroundStepNothingMovesBeforeTheStepAndEventsAreLocated) {
-  const RunOutcome r = run("dynamics_step.yaml");
+  const Result r = run("dynamics_step.yaml");
   const json& d = step_of(r, "dynamics");
   EXPECT_EQ(r.columns, (std::vector<std::string>{"t", "wheel_z", "wheel_vz", "wheel_az"}));
   for (auto& [name, change] : d["max_change_before"]["sensors"].items())
@@ -151,22 +150,22 @@ TEST(Suspension, GroundStepNothingMovesBeforeTheStepAndEventsAreLocated) {
   const int z = column(r, "wheel_z"), az = column(r, "wheel_az");
   // Free fall right after the step: the wheel's acceleration is that of the whole unsprung
   // assembly under gravity and the spring (downwards, larger than g is possible with the spring).
-  for (const auto& row : r.rows) {
+  for (const std::vector<double>& row : r.row_major()) {
     if (row[0] > 0.2005 && row[0] < 0.21) {
       EXPECT_LT(row[az], -9.0) << row[0];
     }
   }
   // Before the step the wheel is at rest at its equilibrium height.
-  EXPECT_NEAR(r.rows.front()[z], 0.277971383717455, 1e-9);
+  EXPECT_NEAR(r.data[z].front(), 0.277971383717455, 1e-9);
 }
 
 // Max |a - b| of a column over the rows both runs share (same output times).
-double max_difference(const RunOutcome& a, const RunOutcome& b, const std::string& name) {
+double max_difference(const Result& a, const Result& b, const std::string& name) {
   const int ca = column(a, name), cb = column(b, name);
-  EXPECT_EQ(a.rows.size(), b.rows.size());
+  EXPECT_EQ(a.rows(), b.rows());
   double m = 0;
-  for (size_t i = 0; i < std::min(a.rows.size(), b.rows.size()); ++i)
-    m = std::max(m, std::fabs(a.rows[i][ca] - b.rows[i][cb]));
+  for (size_t i = 0; i < std::min(a.rows(), b.rows()); ++i)
+    m = std::max(m, std::fabs(a.data[ca][i] - b.data[cb][i]));
   return m;
 }
 
@@ -178,11 +177,11 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
   // the default before issue 13). The default index3 (error per unit step) is 20 to 100 times
   // more accurate at the same tolerance and reaches index 3's accuracy floor (about 1.3e-9 m)
   // from rtol 1e-8 on, so its ratio is checked as the promise below instead.
-  const RunOutcome r6 = run("dynamics_step.yaml", 1e-6, 1e-12, "index3-positions");
-  const RunOutcome r8 = run("dynamics_step.yaml", 1e-8, 1e-14, "index3-positions");
+  const Result r6 = run("dynamics_step.yaml", 1e-6, 1e-12, "index3-positions");
+  const Result r8 = run("dynamics_step.yaml", 1e-8, 1e-14, "index3-positions");
   // The reference: index2-ggl, whose error at 1e-10 (1.5e-10 m, docs/work-precision.md) is below
   // index 3's rounding floor with error per unit step (about 1.3e-9 m from rtol 1e-9 on).
-  const RunOutcome r10 = run("dynamics_step.yaml", 1e-10, 1e-16, "index2-ggl");
+  const Result r10 = run("dynamics_step.yaml", 1e-10, 1e-16, "index2-ggl");
   const double e6 = max_difference(r6, r10, "wheel_z"), e8 = max_difference(r8, r10, "wheel_z");
   RecordProperty("wheel_z_difference_1e-6_1e-10", std::to_string(e6));
   RecordProperty("wheel_z_difference_1e-8_1e-10", std::to_string(e8));
@@ -191,13 +190,13 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
   EXPECT_GT(e6 / e8, 50.0);
   EXPECT_LT(e8, 1e-7);
   // The default index3 at rtol 1e-6 keeps the promise of 10 rtol of wheel_z's scale (0.28 m).
-  const RunOutcome d6 = run("dynamics_step.yaml", 1e-6, 1e-12);
+  const Result d6 = run("dynamics_step.yaml", 1e-6, 1e-12);
   const double e6_default = max_difference(d6, r10, "wheel_z");
   RecordProperty("wheel_z_difference_index3_1e-6", std::to_string(e6_default));
   EXPECT_LT(e6_default, 10 * 1e-6 * 0.28);
   // The scene's default tolerances (rtol 1e-8, atol 1e-14) give wheel_z within 1e-6 m of the
   // tightest run.
-  const RunOutcome rd = run("dynamics_step.yaml");
+  const Result rd = run("dynamics_step.yaml");
   EXPECT_LT(max_difference(rd, r10, "wheel_z"), 1e-6);
   // Events converge too: the same count, times within 1e-6 s.
   const json& ev10 = step_of(r10, "dynamics")["event_times"];
@@ -215,7 +214,7 @@ TEST(Suspension, BallCut5IsFlaggedAsRedundant) {
   o.verbose = false;
   o.progress = false;
   try {
-    run_scene(scene, o);
+    mbdae::run(scene, o);
     ADD_FAILURE() << "redundancy not reported";
   } catch (const ModelError& e) {
     const std::string m = e.what();
@@ -224,7 +223,7 @@ TEST(Suspension, BallCut5IsFlaggedAsRedundant) {
       EXPECT_NE(m.find(std::string("cut ball5: coincident points [") + c + "]"), std::string::npos) << m;
   }
   scene.redundant_constraints = "remove";
-  const RunOutcome r = run_scene(scene, o);
+  const Result r = mbdae::run(scene, o);
   ASSERT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.summary["redundant_constraints"]["redundant"].size(), 3u);
   const ref::SuspensionData data = ref::spec_data();
@@ -242,19 +241,18 @@ TEST(Suspension, FormulationsReproduceIndex3) {
     scene.steps.back().t_end = std::min(scene.steps.back().t_end, 3.0);
     auto run_with = [&](const std::string& formulation, double rtol, double atol) {
       RunOptions o;
-      o.keep_rows = true;
       o.verbose = false;
       o.progress = false;
       o.rtol = rtol;
       o.atol = atol;
       o.formulation = formulation;
-      RunOutcome r = run_scene(scene, o);
+      Result r = mbdae::run(scene, o);
       EXPECT_EQ(r.exit_code, 0) << formulation << " " << r.summary.value("message", "");
       return r;
     };
-    const RunOutcome ref = run_with("index3", 1e-10, 1e-16);
+    const Result ref = run_with("index3", 1e-10, 1e-16);
     for (const char* f : {"index2-ggl", "index1"}) {
-      const RunOutcome r = run_with(f, 1e-8, 1e-14);
+      const Result r = run_with(f, 1e-8, 1e-14);
       const double e = max_difference(r, ref, "wheel_z");
       RecordProperty(std::string(scene_name) + "_" + f, std::to_string(e));
       EXPECT_LT(e, 4e-7) << scene_name << " " << f;
@@ -265,16 +263,15 @@ TEST(Suspension, FormulationsReproduceIndex3) {
 // Damper and tyre removed: kinetic + potential energy (gravity and spring) stays constant.
 TEST(Suspension, FreeOscillationConservesEnergy) {
   RunOptions o;
-  o.keep_rows = true;
   o.verbose = false;
   o.progress = false;
-  const RunOutcome r = run_scene(
+  const Result r = mbdae::run(
       load_scene(std::string(MBDAE_SOURCE_DIR) + "/verification/suspension/scenes/free_oscillation.yaml"), o);
   ASSERT_EQ(r.exit_code, 0) << r.summary.dump(2);
   const int total = column(r, "total"), kinetic = column(r, "kinetic"), z = column(r, "wheel_z");
   double drift = 0, kmax = 0, zmin = 1e9, zmax = -1e9;
-  for (const auto& row : r.rows) {
-    drift = std::max(drift, std::fabs(row[total] - r.rows.front()[total]));
+  for (const std::vector<double>& row : r.row_major()) {
+    drift = std::max(drift, std::fabs(row[total] - r.data[total].front()));
     kmax = std::max(kmax, row[kinetic]);
     zmin = std::min(zmin, row[z]);
     zmax = std::max(zmax, row[z]);

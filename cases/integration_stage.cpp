@@ -1,0 +1,288 @@
+// The integration stage of a run (kinematics or dynamics; cases/run_stages.h): the step's
+// formulation from the registry, consistent initial values, IDA, and every output sample
+// evaluated once into the Result's columns and handed to the sinks.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cases/failure_diagnosis.h"
+#include "cases/run_stages.h"
+#include "cases/step_tolerances.h"
+#include "core/errors.h"
+#include "core/finite_check.h"
+#include "core/ida_driver.h"
+#include "formulation/formulation_registry.h"
+#include "formulation/initial_velocities.h"
+#include "formulation/mechanics.h"
+#include "formulation/sensors.h"
+
+namespace mbdae {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+double automatic_constraint_scale(const System& sys, const AnalysisStep& step) {
+  // Scale the constraint rows like cj^2 M at a typical step (the output step or 1e-3 s).
+  double m = 0;
+  for (const auto& b : sys.bodies) m += b.mass;
+  m = sys.bodies.empty() ? 1.0 : std::max(1e-6, m / sys.bodies.size());
+  const double h = std::min(step.output_step > 0 ? step.output_step : 1e-3, 1e-3);
+  return m / (h * h);
+}
+
+IdaOptions integration_options(const RunOptions& opt, const AnalysisStep& step, const StepTolerances& tol,
+                               json& js) {
+  IdaOptions io;
+  io.t0 = step.t0;
+  io.t1 = step.t_end;
+  io.rtol = opt.rtol > 0 ? opt.rtol : step.rtol;
+  io.atol = tol.absolute.position;
+  io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
+  io.max_step = step.max_step;
+  io.stop = opt.stop;
+  io.nonlinear_convergence = step.newton_convergence;
+  js["newton_convergence"] = io.nonlinear_convergence;
+  js["rtol"] = io.rtol;
+  js["output_projection"] = step.output_projection;
+  js["atol"] = io.atol;
+  js["tolerances"] = to_json(tol);
+  js["output_step"] = io.output_step;
+  return io;
+}
+
+// The DAE of the step's formulation, made by its registry entry.
+std::unique_ptr<MultibodyDae> make_dae(const System& sys, const Formulation& f, const AnalysisStep& step,
+                                       const StepTolerances& tol, json& js) {
+  // Index 3 scales its constraint rows like cj^2 M; the GGL and index-1 rows are scaled by
+  // KLU's row scaling well enough (measured: no difference), so 1 unless the scene sets one.
+  FormulationParameters p;
+  p.constraint_scale = step.constraint_scale > 0 ? step.constraint_scale
+                       : f.automatic_scale     ? automatic_constraint_scale(sys, step)
+                                               : 1.0;
+  p.baumgarte_alpha = tol.baumgarte_alpha;  // the scene's, else from the model's time scale
+  p.baumgarte_beta = tol.baumgarte_beta;
+  p.penalty = step.penalty;
+  js["constraint_scale"] = p.constraint_scale;
+  if (f.uses_penalty && p.penalty > 0) js["penalty"] = p.penalty;
+  if (f.uses_baumgarte) {
+    js["baumgarte_alpha"] = p.baumgarte_alpha;
+    js["baumgarte_beta"] = p.baumgarte_beta;
+  }
+  std::unique_ptr<MultibodyDae> dae = f.make(sys, p);
+  dae->set_absolute_tolerances(tol.absolute);
+  return dae;
+}
+
+// Modes, given initial rates, and consistent (y, y') at t0. False (after fail()) if impossible.
+bool start(RunContext& c, const AnalysisStep& step, MultibodyDae& dae, std::vector<double>& y,
+           std::vector<double>& yp, json& js) {
+  const System& sys = *c.system;
+  dae.modes = initial_modes(sys, c.q.data(), step.t0);
+  dae.track_condition = step.type == AnalysisStep::Type::kKinematics;  // closeness to a singular configuration
+  dae.output_accelerations = false;  // output samples solve for accelerations only if a sensor reports one
+  for (const auto& s : sys.sensors)
+    if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
+  y.assign(dae.size(), 0.0);
+  yp.assign(dae.size(), 0.0);
+  std::copy(c.q.begin(), c.q.end(), y.begin());
+  try {
+    if (!step.initial_velocities.empty()) {
+      // Given rates of joint coordinates; the rest of v from the constraints.
+      std::vector<CoordinateRate> rates;
+      for (const auto& [name, rate] : step.initial_velocities) rates.push_back({sys.coordinate_index(name), rate});
+      solve_initial_velocities(sys, y.data(), step.t0, rates, y.data() + sys.nq());
+    }
+    dae.consistent_initial_values(step.t0, y, yp);
+    if (!step.initial_velocities.empty()) {
+      json rates;
+      for (const auto& [name, rate] : step.initial_velocities)
+        rates[name] = coordinate_rate(sys, sys.coordinate_index(name), y.data(), y.data() + sys.nq());
+      js["initial_velocities"] = rates;  // as reached after the consistent start
+    }
+  } catch (const SolveError& e) {
+    fail(c, e.status, e.what(), js);
+    return false;
+  }
+  return true;
+}
+
+// Evaluates each output sample once: the consistent state, the sensors, the Result's columns
+// (reserved up front), the sinks, the quiet-sensor watch and the progress line.
+struct Sampler {
+  RunContext& c;
+  const AnalysisStep& step;
+  MultibodyDae& dae;
+  std::vector<double> qo, vo, ao, sensors, row;
+  double max_output_violation = 0;
+  std::vector<int> quiet;
+  std::vector<double> quiet_ref, quiet_max;
+  std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now(), last_print = wall0;
+  bool printed = false;
+  bool first_sample = true;
+  std::string sink_error;  // a sink's failure (stops the run)
+
+  Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, double output_step)
+      : c(c_), step(s), dae(d), sensors(c_.system->sensors.size()), row(c_.result.columns.size()) {
+    const System& sys = *c.system;
+    for (const auto& name : step.quiet_sensors)
+      for (size_t k = 0; k < sys.sensors.size(); ++k)
+        if (sys.sensors[k].name == name) quiet.push_back(static_cast<int>(k));
+    quiet_max.assign(quiet.size(), 0.0);
+    const double expected = std::floor((step.t_end - step.t0) / output_step) + 2;
+    const size_t n = static_cast<size_t>(std::min(expected, double(1 << 22)));
+    for (auto& col : c.result.data) col.reserve(col.size() + n);
+  }
+
+  bool operator()(double t, const double* y, const double* yp) {
+    const System& sys = *c.system;
+    max_output_violation =
+        std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
+    if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
+    // Coordinate sensors unwrap against the previous sample (formulation/sensors.h).
+    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(),
+                     first_sample ? nullptr : sensors.data());
+    first_sample = false;
+    row[0] = t;
+    for (size_t k = 0; k < c.column_sensors.size(); ++k) row[k + 1] = sensors[c.column_sensors[k]];
+    if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
+      throw non_finite_error("sensor " + c.result.columns[k], row[k], t);  // the driver stops the run
+    for (size_t k = 0; k < row.size(); ++k) c.result.data[k].push_back(row[k]);
+    if (!c.sinks.empty()) {
+      const Sample sample{t, row.data(), qo.data(), vo.data(), ao.empty() ? nullptr : ao.data(), &dae.modes,
+                          dae.input_time(t)};
+      try {
+        for (Sink* s : c.sinks) s->sample(sample);
+      } catch (const std::exception& e) {
+        sink_error = e.what();
+        return false;
+      }
+    }
+    if (c.options.stop && c.options.stop->load(std::memory_order_relaxed)) return false;
+    if (quiet_ref.empty())
+      for (int k : quiet) quiet_ref.push_back(sensors[k]);
+    if (t < step.quiet_until)
+      for (size_t k = 0; k < quiet.size(); ++k)
+        quiet_max[k] = std::fmax(quiet_max[k], std::fabs(sensors[quiet[k]] - quiet_ref[k]));
+    if (c.options.progress) progress(t);
+    return true;
+  }
+
+  void progress(double t) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - wall0 > std::chrono::seconds(1) && now - last_print > std::chrono::milliseconds(500)) {
+      std::fprintf(stderr, "\r  t = %.4f of %.4f (%3.0f%%)", t, step.t_end, 100.0 * (t - step.t0) / (step.t_end - step.t0));
+      last_print = now;
+      printed = true;
+    }
+  }
+};
+
+json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
+  json stats;
+  stats["steps"] = st.steps;
+  stats["residual_evaluations"] = st.residual_evals;
+  stats["jacobian_evaluations"] = st.jacobian_evals;
+  stats["klu_factorizations"] = st.linear_setups;
+  stats["klu_fresh_factorizations"] = st.fresh_factorizations;
+  stats["error_test_failures"] = st.error_test_failures;
+  stats["nonlinear_iterations"] = st.nonlinear_iterations;
+  stats["nonlinear_failures"] = st.nonlinear_failures;
+  stats["restarts"] = st.restarts;
+  stats["cpu_seconds"] = st.cpu_seconds;
+  stats["max_position_violation_steps"] = dae.max_position_violation;
+  stats["max_position_violation_output_before_projection"] = s.max_output_violation;
+  stats["max_euler_norm_drift"] = dae.max_norm_drift;
+  stats["max_velocity_violation_steps"] = dae.max_velocity_violation;
+  if (dae.track_condition) {
+    // Closeness to a singular configuration along a kinematic run.
+    stats["max_constraint_condition"] = dae.max_condition;
+    stats["max_constraint_condition_time"] = dae.max_condition_time;
+  }
+  stats["output_rows"] = rows;
+  return stats;
+}
+
+// The last configuration reached and, if the constraint Jacobian is singular there, why the run
+// cannot go on (a drive past the mechanism's travel, a dead centre).
+void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const std::vector<double>& y, json& js) {
+  std::string message = st.message;
+  if (st.status == "integration_failed") {
+    const System& sys = *c.system;
+    const FailureDiagnosis d = diagnose_integration_failure(
+        sys, dae.modes, c.column_sensors, c.q.data(), y.data() + sys.nq(), st.t_reached, dae.input_time(st.t_reached),
+        dae.augmented().constraint_condition(c.q.data()), st.message);
+    for (const auto& [key, value] : d.details.items()) js[key] = value;
+    if (d.singular) {
+      js["solver_message"] = st.message;
+      message = d.message;
+    }
+  }
+  fail(c, st.status, message, js);
+}
+
+}  // namespace
+
+bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
+  const System& sys = *c.system;
+  js["type"] = step.type == AnalysisStep::Type::kKinematics ? "kinematics" : "dynamics";
+  const std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+  const Formulation* f = find_formulation(name);
+  if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
+                           "unknown formulation '" + name + "' (" + formulation_names() + ")");
+  js["formulation"] = name;
+  const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
+  const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
+  const IdaOptions io = integration_options(c.options, step, tol, js);
+  const std::unique_ptr<MultibodyDae> dae = make_dae(sys, *f, step, tol, js);
+  std::vector<double> y, yp;
+  if (!start(c, step, *dae, y, yp, js)) return false;
+  const RunInfo info{&c.scene, &sys, &step, &c.result.columns, &c.result.units};
+  try {
+    for (Sink* s : c.sinks) s->begin(info);
+  } catch (const std::exception& e) {
+    fail(c, "output_failed", e.what(), js);
+    c.result.exit_code = 4;
+    return false;
+  }
+  Sampler sampler(c, step, *dae, io.output_step);
+  const size_t rows_before = c.result.rows();
+  const IdaStats st = integrate(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
+  if (sampler.printed) std::fprintf(stderr, "\n");
+  std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
+  js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
+  js["event_times"] = st.event_times;
+  js["breakpoint_times"] = st.breakpoint_times;
+  js["t_reached"] = st.t_reached;
+  if (!sampler.quiet.empty()) {
+    json qj;
+    for (size_t k = 0; k < sampler.quiet.size(); ++k) qj[sys.sensors[sampler.quiet[k]].name] = sampler.quiet_max[k];
+    js["max_change_before"] = {{"time", step.quiet_until}, {"sensors", qj}};
+  }
+  if (c.options.verbose)
+    std::printf("%s: %ld steps, %ld residual evaluations, %ld KLU factorizations, %zu events, "
+                "cpu %.3f s, max constraint violation %.2e\n",
+                js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
+                st.event_times.size(), st.cpu_seconds, dae->max_position_violation);
+  if (!dae->output_failure.empty()) {
+    fail(c, "output_solve_failed", dae->output_failure, js);
+    return false;
+  }
+  if (!sampler.sink_error.empty()) {  // a file that cannot be written: exit code 4 (docs/errors.md)
+    fail(c, "output_failed", sampler.sink_error, js);
+    c.result.exit_code = 4;
+    return false;
+  }
+  if (!st.ok) {
+    report_failure(c, st, *dae, y, js);
+    return false;
+  }
+  if (st.ok && c.options.stop && c.options.stop->load() && st.t_reached < step.t_end) {
+    fail(c, "interrupted", "interrupted at t = " + std::to_string(st.t_reached), js);
+    return false;
+  }
+  js["status"] = "ok";
+  return true;
+}
+
+}  // namespace mbdae

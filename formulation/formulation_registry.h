@@ -1,0 +1,42 @@
+// The formulations a run can integrate with: name, factory and defaults. The table is built
+// once and never changed (safe from any thread). A new formulation is its own file (a class
+// derived from MultibodyDae) plus one entry in formulation_registry.cpp; the scene loader, the
+// command line and the run find it here.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "formulation/multibody_dae.h"
+
+namespace mbdae {
+
+// What a factory may use from an analysis step (defaults as in a scene without these fields).
+struct FormulationParameters {
+  double constraint_scale = 1.0;                     // row scale of the constraint equations
+  double baumgarte_alpha = 20.0, baumgarte_beta = 20.0;  // [1/s] stabilization (index1, penalty);
+                                                         // a run derives them from the model (cases/step_tolerances.h)
+  double penalty = 1e7;  // p = penalty * largest body mass (penalty)
+};
+
+struct Formulation {
+  std::string name;
+  std::string description;  // one line
+  // Default constraint row scale: cj^2 M at a typical step (true), else 1.
+  bool automatic_scale = false;
+  // Uses FormulationParameters::penalty (reported in the summary).
+  bool uses_penalty = false;
+  std::unique_ptr<MultibodyDae> (*make)(const System& sys, const FormulationParameters& p) = nullptr;
+  // Uses the Baumgarte rates (reported in the summary).
+  bool uses_baumgarte = false;
+};
+
+// Every registered formulation, in the order they are documented (index3 first: the default).
+const std::vector<Formulation>& formulation_registry();
+// The entry named `name`, or null.
+const Formulation* find_formulation(const std::string& name);
+// "index3, index2-ggl, index1, penalty" (or with " or " before the last: `last_or`).
+std::string formulation_names(bool last_or = false);
+
+}  // namespace mbdae
