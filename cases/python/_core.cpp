@@ -13,6 +13,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "cases/animation_sink.h"
 #include "cases/mbdae.h"
 #include "cases/sinks.h"
 #include "core/output.h"
@@ -23,18 +24,31 @@ namespace py = pybind11;
 namespace {
 
 // The API's RunOptions plus the folder that run(out=) writes results.csv and summary.json to
-// (through the CLI's sinks, cases/sinks.h).
+// (through the CLI's sinks, cases/sinks.h) and the folder of run(animation=) (an AnimationSink,
+// cases/animation_sink.h).
 struct PyRunOptions : mbdae::RunOptions {
-  std::string out_dir;
+  std::string out_dir, animation_dir;
+  double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
 };
 
-// mbdae::run with the CLI's sinks when an output folder is given.
+// mbdae::run with the CLI's sinks when an output folder is given, and the animation sink.
 mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
-  if (options.out_dir.empty()) return mbdae::run(scene, options);
-  mbdae::prepare_output_folder(options.out_dir);
-  mbdae::CsvSink csv(options.out_dir + "/results.csv");
-  mbdae::SummarySink summary(options.out_dir + "/summary.json");
-  return mbdae::run(scene, options, {&csv, &summary});
+  std::vector<mbdae::Sink*> sinks;
+  std::unique_ptr<mbdae::CsvSink> csv;
+  std::unique_ptr<mbdae::SummarySink> summary;
+  std::unique_ptr<mbdae::AnimationSink> animation;
+  if (!options.out_dir.empty()) {
+    mbdae::prepare_output_folder(options.out_dir);
+    csv = std::make_unique<mbdae::CsvSink>(options.out_dir + "/results.csv");
+    summary = std::make_unique<mbdae::SummarySink>(options.out_dir + "/summary.json");
+    sinks = {csv.get(), summary.get()};
+  }
+  if (!options.animation_dir.empty()) {
+    mbdae::prepare_output_folder(options.animation_dir);
+    animation = std::make_unique<mbdae::AnimationSink>(scene, options.animation_dir, options.animation_rate);
+    sinks.push_back(animation.get());
+  }
+  return mbdae::run(scene, options, sinks);
 }
 
 // A column of a Result as a read-only numpy array over the Result's own memory (no copy): the
@@ -122,7 +136,9 @@ void bind_run(py::module_& m) {
       .def_readwrite("analysis", &mbdae::RunOptions::analysis)
       .def_readwrite("verbose", &mbdae::RunOptions::verbose)
       .def_readwrite("progress", &mbdae::RunOptions::progress)
-      .def_readwrite("out_dir", &PyRunOptions::out_dir);
+      .def_readwrite("out_dir", &PyRunOptions::out_dir)
+      .def_readwrite("animation_dir", &PyRunOptions::animation_dir)
+      .def_readwrite("animation_rate", &PyRunOptions::animation_rate);
   py::class_<mbdae::Result, std::shared_ptr<mbdae::Result>>(m, "Result")
       .def_readonly("status", &mbdae::Result::status)
       .def_readonly("message", &mbdae::Result::message)

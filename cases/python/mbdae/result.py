@@ -73,4 +73,13 @@ class Result:
                          self._summary_json, self.q))
 
     # ---- Writers over the result ------------------------------------------------------------
-    # (The animation sink's `Result.animation(...)` belongs here.)
+    animation_dir = None  # set by Scene.run(animation=...)
+
+    def animation(self, out, **options):
+        """Draws the run's animation (Scene.run(animation=...)) into `out`, an .mp4 (ffmpeg) or
+        .gif, with matplotlib: options fps, start, end, max_frames, size, elev, azim, title
+        (cases/animation/video.py). Returns `out`."""
+        if not self.animation_dir:
+            raise ValueError("this result has no animation: run the scene with animation=True or animation=DIR")
+        from . import _video
+        return _video.animation(self.animation_dir, str(out), **options)

@@ -102,16 +102,27 @@ class Scene:
         return opt
 
     def run(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, out=None,
-            raise_on_failure=True):
+            raise_on_failure=True, animation=None, animation_rate=None):
         """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
         override the scene's when given; `analysis` (an index or a step type such as "dynamics")
-        stops after that step; `out` also writes results.csv and summary.json there. Returns a
-        Result; a failed solve raises SolveError carrying the partial Result (or returns it,
-        with raise_on_failure=False). The GIL is released while solving."""
+        stops after that step; `out` also writes results.csv and summary.json there. `animation`
+        (a folder, or True for `out` or a new temporary folder) also writes the run as a ParaView
+        time series (animation.pvd, docs/animation.md) that Result.animation() draws as a video;
+        `animation_rate` sets its frames per second of simulated time. Returns a Result; a failed
+        solve raises SolveError carrying the partial Result (or returns it, with
+        raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis)
         if out is not None:
             opt.out_dir = str(out)
+        if animation is True:
+            import tempfile
+            animation = out if out is not None else tempfile.mkdtemp(prefix="mbdae_animation_")
+        if animation:
+            opt.animation_dir = str(animation)
+        if animation_rate is not None:
+            opt.animation_rate = _positive("animation_rate", animation_rate)
         result = Result._from_core(_scene_errors(_core.run, self._core, opt))
+        result.animation_dir = opt.animation_dir or None
         if opt.analysis >= 0 and len(result.summary.get("steps", [])) > opt.analysis + 1:
             raise NotImplementedError("run(analysis=...): this build's mbdae::run ignores RunOptions::analysis")
         if raise_on_failure and not result.ok:
