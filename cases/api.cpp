@@ -6,7 +6,7 @@
 
 namespace mbdae {
 
-std::vector<std::string> formulations() { return {"index3", "index2-ggl", "index1", "penalty"}; }
+std::vector<std::string> formulations() { return {"index3", "index3-positions", "index2-ggl", "index1", "penalty"}; }
 
 int Result::column_index(const std::string& name) const {
   for (size_t k = 0; k < columns.size(); ++k)

@@ -45,6 +45,10 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
     for (const auto& f : known) list += (list.empty() ? "" : ", ") + f;
     return "--formulation: expected one of " + list + ", got '" + opt.formulation + "'";
   }
+  if (a == "--error-estimate") {
+    cl.error_estimate = true;
+    return "";
+  }
   if (a == "--quiet") {
     opt.verbose = opt.progress = false;
     return "";
@@ -57,7 +61,7 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
 
 void print_usage() {
   std::fprintf(stderr,
-               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet]\n"
+               "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
                "                  [--output-step DT]\n"
                "                  [--formulation index3|index2-ggl|index1|penalty]\n"
                "       mbdae check SCENE.yaml\n");

@@ -1,5 +1,5 @@
 // The command line of mbdae (cases/main.cpp):
-//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet]
+//   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet] [--error-estimate]
 //                         [--formulation index3|index2-ggl|index1|penalty]
 //   mbdae check SCENE.yaml
 // Overrides are checked with the scene fields' own range checks (cases/field_ranges.h): the
@@ -19,6 +19,7 @@ struct CommandLine {
   std::string scene_path;
   RunOptions options;
   bool show_usage = false;  // after an error: the usage text helps
+  bool error_estimate = false;  // --error-estimate (cases/error_estimate.h)
 };
 
 // Reads the arguments after the program name; returns "" or the usage error (exit code 1).

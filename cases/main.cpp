@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cases/cli_options.h"
+#include "cases/error_estimate.h"
 #include "cases/run_scene.h"
 #include "cases/scene.h"
 #include "cases/signals.h"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
     const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(opt.out_dir, {"results.csv", "summary.json"});
+    if (cl.error_estimate || mbdae::error_estimate_requested(scene)) return mbdae::run_with_error_estimate(scene, opt);
     const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
     const bool interrupted = r.summary.value("status", std::string()) == "interrupted";
     return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;

@@ -1,4 +1,5 @@
 #include "cases/run_scene.h"
+#include "cases/step_tolerances.h"
 
 #include <chrono>
 #include <cmath>
@@ -317,7 +318,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         io.t0 = step.t0;
         io.t1 = step.t_end;
         io.rtol = opt.rtol > 0 ? opt.rtol : step.rtol;
-        io.atol = opt.atol > 0 ? opt.atol : step.atol;
+        const StepTolerances tolerances = step_tolerances(sys, q.data(), step, io.rtol, opt.atol);
+        io.atol = tolerances.absolute.position;
         io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
         io.max_step = step.max_step;
         io.stop = opt.stop;
@@ -326,15 +328,17 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         js["rtol"] = io.rtol;
         js["output_projection"] = step.output_projection;
         js["atol"] = io.atol;
+        js["tolerances"] = to_json(tolerances);
         js["output_step"] = io.output_step;
         // Index 3 scales its constraint rows like cj^2 M; the GGL and index-1 rows are scaled by
         // KLU's row scaling well enough (measured: no difference), so 1 unless the scene sets one.
         const double scale = step.constraint_scale > 0 ? step.constraint_scale
-                             : formulation == "index3" ? automatic_constraint_scale(sys, step) : 1.0;
+                             : formulation.rfind("index3", 0) == 0 ? automatic_constraint_scale(sys, step) : 1.0;
         js["constraint_scale"] = scale;
         // The integration is the same for every formulation: run it on whichever DAE was made.
         auto integrate_dae = [&](MultibodyDae& dae) -> bool {
         dae.modes = initial_modes(sys, q.data(), step.t0);
+        dae.set_absolute_tolerances(tolerances.absolute);
         // A kinematic run reports how close it comes to a singular configuration.
         dae.track_condition = step.type == AnalysisStep::Type::kKinematics;
           // Output samples solve for accelerations only if a sensor reports one.
@@ -496,10 +500,12 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
         } else if (formulation == "index1" || formulation == "penalty") {
           const double penalty = formulation == "penalty" ? step.penalty : 0.0;
           if (penalty > 0) js["penalty"] = penalty;
-          Index1Dae dae(sys, scale, BaumgarteParameters{step.baumgarte_alpha, step.baumgarte_beta}, false, penalty);
+          js["baumgarte_alpha"] = tolerances.baumgarte_alpha;
+          js["baumgarte_beta"] = tolerances.baumgarte_beta;
+          Index1Dae dae(sys, scale, BaumgarteParameters{tolerances.baumgarte_alpha, tolerances.baumgarte_beta}, false, penalty);
           integrated = integrate_dae(dae);
         } else {
-          Index3Dae dae(sys, scale);
+          Index3Dae dae(sys, scale, formulation != "index3-positions");
           integrated = integrate_dae(dae);
         }
         if (!integrated) return out;

@@ -15,12 +15,19 @@ struct AnalysisStep {
   Type type = Type::kAssembly;
   std::vector<std::string> hold, release, unknowns;  // unknowns: "force.parameter"
   double t0 = 0, t_end = 1, output_step = 0.01;
-  double rtol = 1e-6, atol = 1e-8, max_step = 0;
+  // atol: absolute tolerance of positions [m]; 0: rtol times the model's length scale. Euler
+  // parameters get atol / length_scale, velocities atol / time_scale unless atol_rotation [1] or
+  // atol_velocity [m/s] are given; the scales are derived from the model unless given
+  // (formulation/tolerance_scales.h).
+  double rtol = 1e-6, atol = 0, max_step = 0;
+  double length_scale = 0, time_scale = 0, atol_rotation = 0, atol_velocity = 0;
+  bool error_estimate = false;  // repeat the run at rtol / 100 to estimate its error (cases/error_estimate.h)
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
   bool output_projection = false;    // project output samples onto the constraints
-  std::string formulation = "index3";  // index3, index2-ggl, index1 or penalty
-  double baumgarte_alpha = 20.0, baumgarte_beta = 20.0;  // index1, penalty: stabilization [1/s]
+  std::string formulation = "index3";  // index3, index3-positions, index2-ggl, index1 or penalty
+  // index1, penalty: stabilization [1/s]; negative: 5 / the model's fast time scale.
+  double baumgarte_alpha = -1, baumgarte_beta = -1;
   double penalty = 1e7;  // penalty: p = penalty * largest body mass [kg] (formulation/index1_dae.h)
   // Report the largest change of these sensors before this time ("nothing moves before").
   double quiet_until = -1;

@@ -764,6 +764,7 @@ struct Loader {
     s.where = where(n);
     static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
                                    "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
+                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
                                    "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg", "initial_velocities"};
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
@@ -778,6 +779,7 @@ struct Loader {
     if (integrates)
       applies(n, "a " + type + " step", general,
               {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
+                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
                "quiet_until", "quiet_sensors", "initial_velocities"});
     if (type == "kinematics" && has(n, "initial_velocities"))
       error(n["initial_velocities"], "initial_velocities",
@@ -814,6 +816,11 @@ struct Loader {
       if (v == "true") s.output_projection = true;
       else if (v != "false") error(at(n, "output_projection"), "output_projection", "expected true or false, got " + quote(v));
     }
+    if (has(n, "error_estimate")) {
+      const std::string v = text(n, "error_estimate", "false");
+      if (v == "true") s.error_estimate = true;
+      else if (v != "false") error(at(n, "error_estimate"), "error_estimate", "expected true or false, got " + quote(v));
+    }
     const auto epcon = opt_number(n, "newton_convergence");
     s.newton_convergence = epcon.value_or(s.newton_convergence);
     if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))
@@ -823,8 +830,15 @@ struct Loader {
     s.formulation = text(n, "formulation", "index3");
     s.baumgarte_alpha = opt_number(n, "baumgarte_alpha").value_or(s.baumgarte_alpha);
     s.baumgarte_beta = opt_number(n, "baumgarte_beta").value_or(s.baumgarte_beta);
-    if (!(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
-    if (!(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
+    // Tolerances in model units (formulation/tolerance_scales.h): absent means derived.
+    for (auto [key, field] : {std::pair<const char*, double*>{"length_scale", &s.length_scale}, {"time_scale", &s.time_scale},
+                              {"atol_rotation", &s.atol_rotation}, {"atol_velocity", &s.atol_velocity}}) {
+      const auto x = opt_number(n, key);
+      if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
+      else if (x) *field = *x;
+    }
+    if (has(n, "baumgarte_alpha") && !(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
+    if (has(n, "baumgarte_beta") && !(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
     s.penalty = opt_number(n, "penalty").value_or(s.penalty);
     if (!(s.penalty > 0)) error(at(n, "penalty"), "penalty", "must be positive, got " + format_number(s.penalty));
     s.quiet_until = quiet_until.value_or(s.quiet_until);
@@ -851,9 +865,10 @@ struct Loader {
     if (scale && s.constraint_scale < 0)
       error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
     if (has(n, "formulation") && n["formulation"].IsScalar() && s.formulation != "index3" &&
-        s.formulation != "index2-ggl" && s.formulation != "index1" && s.formulation != "penalty")
+        s.formulation != "index3-positions" && s.formulation != "index2-ggl" && s.formulation != "index1" &&
+        s.formulation != "penalty")
       error(n["formulation"], "formulation",
-            "unknown formulation " + quote(s.formulation) + " (index3, index2-ggl, index1, penalty)");
+            "unknown formulation " + quote(s.formulation) + " (index3, index3-positions, index2-ggl, index1, penalty)");
     if (integrates && !s.quiet_sensors.empty() && !has(n, "quiet_until"))
       error(n["quiet_sensors"], "quiet_until", "missing (quiet_sensors are watched until quiet_until)");
     return s;

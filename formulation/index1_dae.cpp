@@ -54,9 +54,7 @@ void Index1Dae::error_test_mask(double* id) const {
 void Index1Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {
   const double noise = position_noise(y);
   const double al = mass_scale_ * (atol + noise) / h;
-  const double aq = position_atol(y, atol), av = velocity_atol(h, y, atol);
-  position_weights(y, rtol, aq, w);
-  for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
+  state_weights(h, y, rtol, atol, w);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 

@@ -6,8 +6,8 @@
 
 namespace mbdae {
 
-Index3Dae::Index3Dae(const System& sys, double constraint_scale)
-    : MultibodyDae(sys), scale_(constraint_scale) {
+Index3Dae::Index3Dae(const System& sys, double constraint_scale, bool error_per_unit_step)
+    : MultibodyDae(sys), scale_(constraint_scale), per_unit_step_(error_per_unit_step) {
   record_pattern();
 }
 
@@ -37,7 +37,14 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
   // atol, bounds how tightly they can converge.
   const double noise = position_noise(y);
   const double av = atol + noise / h, al = mass_scale_ * (atol + noise / (h * h));
-  position_weights(y, rtol, position_atol(y, atol), w);
+  if (per_unit_step_ && abs_tol_.set()) {
+    // Error per unit step: q's tolerances times step / T, not below the rounding noise.
+    state_weights(h, y, rtol, atol, w);
+    const double f = std::fmax(1.0, abs_tol_.time / newton_step(h));
+    for (int i = 0; i < nq_; ++i) w[i] = std::fmin(w[i] * f, std::fmax(w[i], 1.0 / noise));
+  } else {
+    position_weights(y, rtol, position_atol(y, atol), w);
+  }
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }

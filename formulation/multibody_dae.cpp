@@ -110,6 +110,22 @@ void MultibodyDae::position_weights(const double* y, double rtol, double aq, dou
   for (int i = 0; i < nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + aq);
 }
 
+void MultibodyDae::state_weights(double h, const double* y, double rtol, double atol, double* w) const {
+  const double aq = position_atol(y, abs_tol_.set() ? abs_tol_.position : atol);
+  // Euler parameters floored like every coordinate before model-unit tolerances: at ten
+  // roundings of the largest coordinate (a 40-bar four-bar whose couplers' e1..e3 stay 0 fails
+  // with a floor of ten roundings of 1).
+  const double ap = abs_tol_.set() ? position_atol(y, abs_tol_.rotation) : aq;
+  const double av = velocity_atol(h, y, abs_tol_.set() ? abs_tol_.velocity : atol);
+  const double ar = abs_tol_.set() ? velocity_atol(h, y, abs_tol_.rotation_rate) : av;
+  for (int i = 0; i < nq_; ++i) {
+    const bool euler = i % 7 >= 3;
+    const double a_q = euler ? ap : aq;
+    w[i] = 1.0 / (rtol * std::fabs(y[i]) + a_q);
+    w[nq_ + i] = 1.0 / (rtol * std::fabs(y[nq_ + i]) + (euler ? ar : av));
+  }
+}
+
 void MultibodyDae::switches(double t_in, const double* y, double* g) {
   const double t = input_time(t_in);
   for (size_t k = 0; k < switch_forces_.size(); ++k) {

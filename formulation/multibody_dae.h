@@ -24,6 +24,15 @@
 
 namespace mbdae {
 
+// Absolute tolerances in the model's units (formulation/tolerance_scales.h): positions [m],
+// Euler parameters [1], velocities [m/s], Euler-parameter rates [1/s]. All zero: the single
+// atol the integrator passes applies to every component (the behaviour before issue 13).
+struct AbsoluteTolerances {
+  double position = 0, rotation = 0, velocity = 0, rotation_rate = 0;
+  double time = 1;  // [s] the model's time scale (velocity scale length / time)
+  bool set() const { return position > 0; }
+};
+
 class MultibodyDae : public DaeProblem {
  public:
   explicit MultibodyDae(const System& sys);
@@ -132,6 +141,21 @@ class MultibodyDae : public DaeProblem {
   // 22108). The plain relative test keeps the accuracy a tolerance promises.
   void position_weights(const double* y, double rtol, double aq, double* w) const;
   double newton_cj_ = 0;  // cj of the last Newton matrix (set by jacobian())
+
+ public:
+  // Per-kind absolute tolerances (set once, before integrating; see AbsoluteTolerances).
+  void set_absolute_tolerances(const AbsoluteTolerances& a) { abs_tol_ = a; }
+  const AbsoluteTolerances& absolute_tolerances() const { return abs_tol_; }
+
+ protected:
+  // Weights of q and v, w_i = 1 / (rtol |y_i| + a_i), a_i the absolute tolerance of the
+  // component's kind (position or Euler parameter, velocity or Euler-parameter rate; `atol` for
+  // all when no model-unit tolerances are set), floored at rounding (position_atol,
+  // velocity_atol).
+  void state_weights(double h, const double* y, double rtol, double atol, double* w) const;
+  // The integrator's step: 1/cj of the last Newton matrix (h before the first one).
+  double newton_step(double h) const { return newton_cj_ > 0 ? 1.0 / newton_cj_ : h; }
+  AbsoluteTolerances abs_tol_;
 
   const System& sys_;
   std::vector<int> offsets_;

@@ -132,10 +132,10 @@ def work_precision(args):
                      "samples at t0 and t_end only (their step count: steps_no_output); wall_median: wall time of the whole "
                      "scene (assembly and equilibrium included) on a shared machine." % (meta["atol_ratio"],
                                                                                           meta["repeat"]))
-        parts.append("- Reference: index3, rtol %g, atol %g: %s, %s steps, %s s CPU. Its check at rtol %g, "
+        parts.append("- Reference: %s, rtol %g, atol %g: %s, %s steps, %s s CPU. Its check at rtol %g, "
                      "atol %g (%s) differs from it by at most %s m (wheel_z), %s m/s (wheel_vz), %s m/s^2 "
                      "(wheel_az) over %s common samples." % (
-                         ref["rtol"], ref["atol"], ref["status"], g(ref["steps"], 7), g(ref["cpu_seconds"]),
+                         ref.get("formulation", "index3"), ref["rtol"], ref["atol"], ref["status"], g(ref["steps"], 7), g(ref["cpu_seconds"]),
                          chk["rtol"], chk["atol"], chk["status"], g(chk["diff_z"]), g(chk["diff_vz"]),
                          g(chk["diff_az"]), chk["samples"]))
         rng = ref.get("signal_range", {})

@@ -1,0 +1,140 @@
+// mbdae._core: the pybind11 bindings of the public API (cases/mbdae.h), kept thin. The Python
+// package around it (cases/python/mbdae/) adds the pandas / numpy views, the exceptions with
+// their fields, and the Dask sweeps.
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "cases/mbdae.h"
+#include "core/errors.h"
+
+namespace py = pybind11;
+
+namespace {
+
+// A column of a Result as a read-only numpy array over the Result's own memory (no copy): the
+// array keeps the Python Result object (and so the C++ Result) alive.
+py::array column_view(py::object owner, const mbdae::Result& r, size_t k) {
+  if (k >= r.data.size()) throw py::index_error("column index out of range");
+  const std::vector<double>& col = r.data[k];
+  py::array_t<double> a({static_cast<py::ssize_t>(col.size())}, {static_cast<py::ssize_t>(sizeof(double))},
+                        col.data(), owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return std::move(a);
+}
+
+unsigned long main_thread_id() {
+  static const unsigned long id =
+      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  return id;
+}
+
+const char* step_type_name(mbdae::AnalysisStep::Type t) {
+  switch (t) {
+    case mbdae::AnalysisStep::Type::kAssembly: return "assembly";
+    case mbdae::AnalysisStep::Type::kEquilibrium: return "equilibrium";
+    case mbdae::AnalysisStep::Type::kKinematics: return "kinematics";
+    case mbdae::AnalysisStep::Type::kDynamics: return "dynamics";
+  }
+  return "?";
+}
+
+// Runs on a private copy of the scene (another Python thread may change the caller's Scene) with
+// the GIL released, so runs in Python threads proceed in parallel. In the main thread the run goes
+// to a helper thread while this one checks for Ctrl-C every 50 ms: a signal stops the run at its
+// next step (RunOptions::stop) and is raised (KeyboardInterrupt) once the run has ended.
+std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, mbdae::RunOptions options) {
+  const mbdae::Scene copy = scene;
+  const bool main_thread = PyThread_get_thread_ident() == main_thread_id();
+  if (!main_thread) {
+    py::gil_scoped_release release;
+    return std::make_shared<mbdae::Result>(mbdae::run(copy, options));
+  }
+  std::atomic<bool> stop{false};
+  options.stop = &stop;
+  auto job = std::async(std::launch::async, [&] { return std::make_shared<mbdae::Result>(mbdae::run(copy, options)); });
+  bool interrupted = false;
+  while (true) {
+    {
+      py::gil_scoped_release release;
+      if (job.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready) break;
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {
+      interrupted = true;  // the error stays set; the run ends at its next step
+      stop = true;
+    }
+  }
+  auto result = job.get();
+  if (interrupted) throw py::error_already_set();
+  return result;
+}
+
+void bind_scene(py::module_& m) {
+  py::class_<mbdae::Scene>(m, "Scene")
+      .def("copy", [](const mbdae::Scene& s) { return mbdae::Scene(s); })
+      .def_readonly("file", &mbdae::Scene::file)
+      .def_property_readonly("columns", [](const mbdae::Scene& s) { return s.columns; })
+      .def_property_readonly("step_types", [](const mbdae::Scene& s) {
+        std::vector<std::string> types;
+        for (const auto& step : s.steps) types.push_back(step_type_name(step.type));
+        return types;
+      });
+  m.def("load_scene", &mbdae::load_scene, py::arg("path"));
+  m.def("load_scene_text", &mbdae::load_scene_text, py::arg("text"), py::arg("path"));
+  m.def("set_parameter", &mbdae::set_parameter, py::arg("scene"), py::arg("path"), py::arg("yaml_value"));
+  m.def("with_parameters", &mbdae::with_parameters, py::arg("scene"), py::arg("overrides"));
+  m.def("formulations", &mbdae::formulations);
+}
+
+void bind_run(py::module_& m) {
+  py::class_<mbdae::RunOptions>(m, "RunOptions")
+      .def(py::init<>())
+      .def_readwrite("rtol", &mbdae::RunOptions::rtol)
+      .def_readwrite("atol", &mbdae::RunOptions::atol)
+      .def_readwrite("output_step", &mbdae::RunOptions::output_step)
+      .def_readwrite("formulation", &mbdae::RunOptions::formulation)
+      .def_readwrite("analysis", &mbdae::RunOptions::analysis)
+      .def_readwrite("verbose", &mbdae::RunOptions::verbose)
+      .def_readwrite("progress", &mbdae::RunOptions::progress)
+      .def_readwrite("out_dir", &mbdae::RunOptions::out_dir);
+  py::class_<mbdae::Result, std::shared_ptr<mbdae::Result>>(m, "Result")
+      .def_readonly("status", &mbdae::Result::status)
+      .def_readonly("message", &mbdae::Result::message)
+      .def_readonly("exit_code", &mbdae::Result::exit_code)
+      .def_readonly("names", &mbdae::Result::columns)
+      .def_readonly("units", &mbdae::Result::units)
+      .def_readonly("q", &mbdae::Result::q)
+      .def_property_readonly("rows", &mbdae::Result::rows)
+      .def_property_readonly("summary_json", [](const mbdae::Result& r) { return r.summary.dump(); })
+      .def("column", [](py::object self, size_t k) { return column_view(self, self.cast<const mbdae::Result&>(), k); });
+  m.def("run", &run_released, py::arg("scene"), py::arg("options"));
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "mbdae's C++ API (cases/mbdae.h); use the mbdae package, not this module";
+  // Scene and model errors as one exception carrying the CLI's lines (file:line: field 'x': ...);
+  // the package turns them into mbdae.SceneError with the fields parsed.
+  static py::exception<mbdae::SceneError> scene_error(m, "SceneErrorLines", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    auto raise = [](const std::vector<std::string>& lines) { PyErr_SetObject(scene_error.ptr(), py::cast(lines).ptr()); };
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const mbdae::SceneError& e) {
+      raise(e.messages);
+    } catch (const mbdae::ModelError& e) {
+      raise({e.what()});
+    }
+  });
+  bind_scene(m);
+  bind_run(m);
+}

@@ -1,0 +1,23 @@
+"""mbdae from Python: scenes, runs and results in memory, and parameter sweeps on Dask.
+
+    import mbdae
+    scene = mbdae.load("cases/five_point_suspension/dynamics_step.yaml")
+    scene.set("forces.tyre.stiffness", 3.0e5)
+    r = scene.run(rtol=1e-8)
+    r.table          # pandas DataFrame: t, then the output sensors
+    r.columns["wheel_z"], r.summary["status"]
+
+    table = mbdae.sweep(scene, {"forces.suspension.damping": [700, 1400, 2800]}, out="build/sweep",
+                        metrics={"travel": mbdae.metrics.peak_deviation("wheel_z")})
+
+See docs/python.md."""
+from . import metrics
+from ._core import formulations
+from .errors import SceneError, SolveError
+from .result import Result
+from .scene import Scene, load
+from .sweep import read_run, sweep
+from .work_precision import work_precision
+
+__all__ = ["Scene", "Result", "SceneError", "SolveError", "load", "sweep", "read_run", "work_precision",
+           "formulations", "metrics"]

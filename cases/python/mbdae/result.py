@@ -1,0 +1,76 @@
+"""Result: what a run produced, as numpy arrays (views of the C++ columns, no copies), a pandas
+table and the summary dict."""
+import json
+
+import numpy as np
+
+
+class Result:
+    """A run's samples and summary. `columns` maps each column name ("t", then the scene's output
+    sensors) to a read-only numpy array; `table` is a pandas DataFrame of the same; `summary` is
+    the content of summary.json as a dict; `status` is "ok" or the failure."""
+
+    def __init__(self, status, message, names, arrays, units, summary_json, q=()):
+        self.status = status
+        self.message = message
+        self.names = list(names)
+        self.units = list(units)
+        self.q = np.asarray(q, dtype=float)
+        self._arrays = list(arrays)
+        self._summary_json = summary_json
+        self._summary = None
+        self._table = None
+
+    @classmethod
+    def _from_core(cls, r):
+        # r.column(k) is a numpy view over the C++ vector and holds r alive.
+        return cls(r.status, r.message, r.names, [r.column(k) for k in range(len(r.names))], r.units,
+                   r.summary_json, r.q)
+
+    @property
+    def ok(self):
+        return self.status == "ok"
+
+    @property
+    def rows(self):
+        return len(self._arrays[0]) if self._arrays else 0
+
+    @property
+    def columns(self):
+        """{name: numpy array}: the samples of each column, not copied."""
+        return dict(zip(self.names, self._arrays))
+
+    def __getitem__(self, name):
+        try:
+            return self._arrays[self.names.index(name)]
+        except ValueError:
+            raise KeyError(f"no column named '{name}' (columns: {', '.join(self.names)})") from None
+
+    @property
+    def table(self):
+        """A pandas DataFrame: `t`, then one column per output sensor (a copy, built once)."""
+        if self._table is None:
+            import pandas as pd
+            self._table = pd.DataFrame(self.columns, columns=self.names)
+        return self._table
+
+    @property
+    def summary(self):
+        """summary.json's content (statistics, solved coordinates, status) as a dict."""
+        if self._summary is None:
+            self._summary = json.loads(self._summary_json) if self._summary_json else {}
+        return self._summary
+
+    def cpu_seconds(self):
+        """The integration steps' CPU time (sum of the steps' statistics.cpu_seconds)."""
+        return sum(s.get("statistics", {}).get("cpu_seconds", 0.0) for s in self.summary.get("steps", []))
+
+    def __repr__(self):
+        return f"<mbdae.Result {self.status}: {self.rows} rows x {len(self.names)} columns>"
+
+    def __reduce__(self):  # pickles as plain arrays (Dask, multiprocessing)
+        return (Result, (self.status, self.message, self.names, [np.array(a) for a in self._arrays], self.units,
+                         self._summary_json, self.q))
+
+    # ---- Writers over the result ------------------------------------------------------------
+    # (The animation sink's `Result.animation(...)` belongs here.)

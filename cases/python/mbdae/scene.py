@@ -1,0 +1,164 @@
+"""Scene: a scene file loaded by the C++ loader, parameter overrides by path, and run()."""
+import json
+import math
+import os
+
+from . import _core
+from .errors import SceneError, SolveError
+from .result import Result
+
+
+def _scene_errors(call, *args):
+    """Calls into _core, turning its scene errors into mbdae.SceneError."""
+    try:
+        return call(*args)
+    except _core.SceneErrorLines as e:
+        raise SceneError(e.args[0]) from None
+
+
+def yaml_value(value):
+    """A Python value as the YAML text set_parameter takes: numbers exactly (repr round-trips),
+    lists and dicts as flow YAML (JSON), strings as they are (already YAML text)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if hasattr(value, "item") and not isinstance(value, (list, tuple, dict)):  # numpy scalars
+        value = value.item()
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return {math.inf: ".inf", -math.inf: "-.inf"}.get(value, ".nan")
+        return repr(value)
+    if isinstance(value, int):
+        return str(value)
+    return json.dumps(value, default=lambda v: v.item() if hasattr(v, "item") else v.tolist())
+
+
+class Scene:
+    """A scene (model and analyses) ready to run. Build one with mbdae.load(path),
+    Scene.from_yaml(text) or Scene.from_dict(d). Scenes pickle (for Dask) as their source text and
+    overrides and are re-read on the other side; the model file a scene names is read there from
+    the same path."""
+
+    def __init__(self, core, path, text, overrides=()):
+        self._core = core
+        self._path = path        # for messages and to find the model file
+        self._text = text        # None: re-read from path when unpickled
+        self.overrides = list(overrides)  # (path, yaml text) applied in order
+
+    # ---- Building ---------------------------------------------------------------------------
+    @classmethod
+    def from_file(cls, path):
+        return cls(_scene_errors(_core.load_scene, str(path)), os.path.abspath(path), None)
+
+    @classmethod
+    def from_yaml(cls, text, path="<string>.yaml"):
+        """A scene from YAML text; `path` names it in messages and its folder is where a
+        `model:` file is looked for (default: the current folder)."""
+        return cls(_scene_errors(_core.load_scene_text, text, str(path)), str(path), text)
+
+    @classmethod
+    def from_dict(cls, d, path="<dict>.yaml"):
+        """A scene from a dict with the YAML file's structure (written as indented JSON, which is
+        YAML, so messages name the line of that text)."""
+        return cls.from_yaml(json.dumps(d, indent=1, default=lambda v: v.item() if hasattr(v, "item") else v.tolist()),
+                             path)
+
+    # ---- Overrides --------------------------------------------------------------------------
+    def set(self, path, value):
+        """Overrides one parameter by path (forces.suspension.damping, analysis.dynamics.t_end,
+        bodies.wheel.mass, gravity, ...) with the scene file's own validation: a bad value raises
+        SceneError naming the file, line and field. Returns the scene."""
+        text = yaml_value(value)
+        _scene_errors(_core.set_parameter, self._core, path, text)
+        self.overrides.append((path, text))
+        return self
+
+    def with_params(self, params):
+        """A copy with every {path: value} override applied in order; this scene is unchanged."""
+        items = params.items() if hasattr(params, "items") else params
+        overrides = [(p, yaml_value(v)) for p, v in items]
+        core = _scene_errors(_core.with_parameters, self._core, overrides)
+        return Scene(core, self._path, self._text, self.overrides + overrides)
+
+    def copy(self):
+        return Scene(self._core.copy(), self._path, self._text, self.overrides)
+
+    # ---- Running ----------------------------------------------------------------------------
+    def run_options(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None):
+        opt = _core.RunOptions()
+        if rtol is not None:
+            opt.rtol = _positive("rtol", rtol, upper=1.0)
+        if atol is not None:
+            opt.atol = _positive("atol", atol, upper=1.0)
+        if output_step is not None:
+            opt.output_step = _positive("output_step", output_step)
+        if formulation is not None:
+            if formulation not in _core.formulations():
+                raise ValueError(f"formulation expects one of {', '.join(_core.formulations())}, got '{formulation}'")
+            opt.formulation = formulation
+        if analysis is not None:
+            opt.analysis = self._analysis_index(analysis)
+        return opt
+
+    def run(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, out=None,
+            raise_on_failure=True):
+        """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
+        override the scene's when given; `analysis` (an index or a step type such as "dynamics")
+        stops after that step; `out` also writes results.csv and summary.json there. Returns a
+        Result; a failed solve raises SolveError carrying the partial Result (or returns it,
+        with raise_on_failure=False). The GIL is released while solving."""
+        opt = self.run_options(rtol, atol, formulation, output_step, analysis)
+        if out is not None:
+            opt.out_dir = str(out)
+        result = Result._from_core(_scene_errors(_core.run, self._core, opt))
+        if opt.analysis >= 0 and len(result.summary.get("steps", [])) > opt.analysis + 1:
+            raise NotImplementedError("run(analysis=...): this build's mbdae::run ignores RunOptions::analysis")
+        if raise_on_failure and not result.ok:
+            raise SolveError(result)
+        return result
+
+    def _analysis_index(self, analysis):
+        types = self._core.step_types
+        if isinstance(analysis, str):
+            if analysis not in types:
+                raise ValueError(f"analysis '{analysis}': the scene's steps are {', '.join(types)}")
+            return len(types) - 1 - types[::-1].index(analysis)
+        if not 0 <= int(analysis) < len(types):
+            raise ValueError(f"analysis {analysis}: the scene has steps 0 to {len(types) - 1} ({', '.join(types)})")
+        return int(analysis)
+
+    @property
+    def file(self):
+        return self._core.file
+
+    @property
+    def steps(self):
+        """The analysis steps' types, in order."""
+        return list(self._core.step_types)
+
+    def __repr__(self):
+        extra = f", {len(self.overrides)} overrides" if self.overrides else ""
+        return f"<mbdae.Scene {self.file}: {', '.join(self.steps)}{extra}>"
+
+    def __reduce__(self):
+        return (_rebuild, (self._path, self._text, self.overrides))
+
+
+def _rebuild(path, text, overrides):
+    scene = Scene.from_file(path) if text is None else Scene.from_yaml(text, path)
+    if not overrides:
+        return scene
+    return Scene(_scene_errors(_core.with_parameters, scene._core, list(overrides)), path, text, overrides)
+
+
+def _positive(name, value, upper=math.inf):
+    v = float(value)
+    if not (v > 0) or v > upper:
+        raise ValueError(f"{name} expects a number in (0, {upper:g}], got {value!r}")
+    return v
+
+
+def load(path):
+    """Reads a scene file (and the model file it names); a bad file raises SceneError."""
+    return Scene.from_file(path)

@@ -1,0 +1,51 @@
+// The model's length and time scales and the defaults they give (formulation/tolerance_scales.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "formulation/system.h"
+#include "formulation/tests/test_models.h"
+#include "formulation/tolerance_scales.h"
+
+namespace mbdae {
+namespace {
+
+// A pendulum of length d under gravity: L = d (pivot to centre of mass), T = sqrt(d / g).
+TEST(ToleranceScales, PendulumLengthAndTime) {
+  for (double d : {0.03, 1.0}) {
+    Model m = testing::pendulum(2.0, d, 0.1, 0.0);
+    m.gravity = Vec3(0, 0, -9.81);
+    const System sys = build_system(m);
+    const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 10.0);
+    EXPECT_NEAR(s.length, d, 1e-12 * d);
+    EXPECT_NEAR(s.time, std::sqrt(d / 9.81), 1e-12);
+    EXPECT_EQ(s.fast_time, s.time);
+    // Baumgarte alpha = beta = 5 / T_f: 15.7/s for the 1 m pendulum (20/s was the fixed default).
+    EXPECT_NEAR(default_baumgarte_rate(s), 5.0 / std::sqrt(d / 9.81), 1e-9);
+    // Absolute tolerances in model units from a_q = rtol L.
+    const AbsoluteTolerances a = absolute_tolerances(s, default_position_atol(s, 1e-6));
+    EXPECT_NEAR(a.position, 1e-6 * d, 1e-20);
+    EXPECT_NEAR(a.rotation, 1e-6, 1e-18);          // the same for a 3 cm and a 1 m pendulum
+    EXPECT_NEAR(a.velocity, 1e-6 * d / s.time, 1e-18);
+    EXPECT_NEAR(a.rotation_rate, 1e-6 / s.time, 1e-15);
+  }
+}
+
+// Without gravity the time scale is the span; a spring's sqrt(m/k) sets the fast time scale.
+TEST(ToleranceScales, SpanAndSpring) {
+  Model m = testing::pendulum(2.0, 0.5, 0.1, 0.0);
+  m.gravity = Vec3::Zero();
+  System sys = build_system(m);
+  EXPECT_NEAR(model_scales(sys, sys.q0.data(), 0.0, 3.0).time, 3.0, 1e-15);
+  Force spring;
+  spring.type = ForceSpec::Type::kSpringDamper;
+  spring.bi = 0;
+  spring.stiffness = 800.0;
+  sys.forces.push_back(spring);
+  const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 3.0);
+  EXPECT_NEAR(s.fast_time, std::sqrt(2.0 / 800.0), 1e-15);
+  EXPECT_NEAR(default_baumgarte_rate(s), 100.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace mbdae

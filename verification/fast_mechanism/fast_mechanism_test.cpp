@@ -1,0 +1,88 @@
+// The fast mechanism (slider_crank_fast.yaml) against its one-degree-of-freedom Lagrange
+// reference: the reference converged and fast enough; every formulation at the scene's default
+// tolerances against it, for positions and velocities alike; index3's error per unit step against
+// the positions-only test; the global error estimate (issue 13).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "cases/error_estimate.h"
+#include "verification/fast_mechanism/fast_mechanism_errors.h"
+#include "verification/fast_mechanism/slider_crank_reference.h"
+
+namespace mbdae {
+namespace {
+
+TEST(FastMechanism, ReferenceConvergedAndFast) {
+  std::vector<double> times;
+  for (int k = 0; k <= 200; ++k) times.push_back(1e-4 * k);
+  const auto fine = slider_crank_reference({}, times, 1e-13);
+  const auto coarse = slider_crank_reference({}, times, 1e-12);
+  double d_theta = 0, d_rate = 0;
+  for (size_t k = 0; k < times.size(); ++k) {
+    d_theta = std::max(d_theta, std::fabs(fine[k].theta - coarse[k].theta));
+    d_rate = std::max(d_rate, std::fabs(fine[k].rate - coarse[k].rate));
+  }
+  EXPECT_LT(d_theta, 1e-10);  // rad
+  EXPECT_LT(d_rate / fine.back().rate, 1e-10);
+  EXPECT_GT(fine.back().rate, 1000.0);  // rad/s within the run
+}
+
+Result run_fast(const Scene& scene, const std::string& formulation) {
+  RunOptions opt;
+  opt.formulation = formulation;
+  return run(scene, opt);
+}
+
+// Every formulation at the scene's default tolerances (rtol 1e-6, atol from the model's scales)
+// against the reference. The issue's promise, 10 rtol of each quantity's scale, is NOT met on this
+// case by any formulation (measured 3.8e-5 to 5.5e-4 relative, docs/work-precision.md): the
+// crank's phase error grows with omega t. Asserted: 3 correct digits of every position and
+// velocity at 1100 rad/s, and the error estimate says that the promise is missed.
+class FastMechanismFormulation : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FastMechanismFormulation, DefaultTolerancesGiveThreeDigits) {
+  const Scene scene = load_fast_mechanism();
+  const Result r = run_fast(scene, GetParam());
+  ASSERT_TRUE(r.ok()) << r.message;
+  const FastMechanismErrors e = fast_mechanism_errors(r);
+  const double rtol = scene.steps.back().rtol;
+  for (size_t k = 0; k < e.sensors.size(); ++k)
+    EXPECT_LE(e.error[k], 1e-3 * e.scale[k])
+        << GetParam() << ": " << e.sensors[k] << " error " << e.error[k] << " on a scale of " << e.scale[k];
+  std::printf("%s: relative errors positions %.3g, velocities %.3g (%.0f and %.0f rtol)\n", GetParam().c_str(),
+              e.position, e.velocity, e.position / rtol, e.velocity / rtol);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formulations, FastMechanismFormulation,
+                         ::testing::Values("index3", "index2-ggl", "index1", "penalty"));
+
+// Error per unit step (index3) against the positions-only test (index3-positions): measured 28x.
+TEST(FastMechanism, Index3ErrorPerUnitStepBeatsPositionsOnly) {
+  const Scene scene = load_fast_mechanism();
+  const FastMechanismErrors unit_step = fast_mechanism_errors(run_fast(scene, "index3"));
+  const FastMechanismErrors positions = fast_mechanism_errors(run_fast(scene, "index3-positions"));
+  EXPECT_LT(10 * unit_step.position, positions.position);
+  EXPECT_LT(10 * unit_step.velocity, positions.velocity);
+}
+
+// The error estimate (cases/error_estimate.h) finds the error within a factor 3 and warns.
+TEST(FastMechanism, ErrorEstimateSeesTheMissedPromise) {
+  const Scene scene = load_fast_mechanism();
+  RunOptions opt;
+  const Result r = run(scene, opt);
+  ASSERT_TRUE(r.ok());
+  const FastMechanismErrors truth = fast_mechanism_errors(r);
+  const ErrorEstimate est = estimate_global_error(scene, opt, r);
+  ASSERT_EQ(est.reference_status, "ok");
+  ASSERT_EQ(est.sensors.size(), truth.sensors.size());
+  for (size_t k = 0; k < est.sensors.size(); ++k) {
+    EXPECT_GT(est.error[k], truth.error[k] / 3) << est.sensors[k];
+    EXPECT_LT(est.error[k], truth.error[k] * 3) << est.sensors[k];
+  }
+  EXPECT_EQ(est.exceeded.size(), est.sensors.size());
+}
+
+}  // namespace
+}  // namespace mbdae
