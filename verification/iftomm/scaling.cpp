@@ -475,7 +475,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> head = {
       "N", "bodies", "unknowns", "Jacobian nnz", "redundant", "build_system s", "projection s", "SPQR s",
       "steps", "residuals", "Jacobians", "KLU factorizations (fresh)", "CPU s", "ms/step", "ms/residual",
-      "ms/Jacobian", "ms/KLU refactor", "ms/KLU fresh factor", "ms/KLU solve", "KLU rcond", "rest ms/step",
+      "ms/Jacobian", "us/step/body", "nnz(L+U)", "KLU Mflop/factor", "ms/KLU refactor", "ms/KLU fresh factor", "ms/KLU solve", "KLU rcond", "rest ms/step",
       "peak RSS MB",
       "theta(0.5) error"};
   std::vector<std::vector<std::string>> rows;
@@ -488,7 +488,8 @@ int main(int argc, char** argv) {
                     std::to_string(r.setups) + " (" + std::to_string(r.fresh) + ")",
                     fmt("%.3f", r.integrate_s), fmt("%.4g", 1e3 * r.integrate_s / r.steps),
                     fmt("%.4g", 1e3 * r.residual_s / r.residuals), fmt("%.4g", 1e3 * r.jacobian_s / r.jacobians),
-                    fmt("%.4g", 1e3 * r.klu_refactor_s), fmt("%.4g", 1e3 * r.klu_first_s),
+                    fmt("%.3g", 1e6 * r.integrate_s / r.steps / r.bodies), std::to_string(r.lu_nnz),
+                    fmt("%.3g", 1e-6 * r.flops), fmt("%.4g", 1e3 * r.klu_refactor_s), fmt("%.4g", 1e3 * r.klu_first_s),
                     fmt("%.4g", 1e3 * r.klu_solve_s), fmt("%.1e", r.rcond), fmt("%.4g", 1e3 * rest),
                     fmt("%.1f", r.peak_kb / 1024.0), fmt("%.1e", std::fabs(r.theta_end - r.theta_ref))});
   }
