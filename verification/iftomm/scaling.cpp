@@ -1,7 +1,9 @@
-// Scaling of mbdae with the size of the IFToMM A02 N four-bar mechanism (docs/scaling.md).
+// Scaling of mbdae with the size of the IFToMM A02 N four-bar mechanism, or (--chain, --tree)
+// of a serial chain or binary tree of the same rods, 0.05 s released at rest (docs/scaling.md).
 //
 //   iftomm_scaling [N ...]           default N = 10 100 1000 10000
 //   iftomm_scaling --markdown [N ...]  the same, as the markdown table of docs/scaling.md
+//   iftomm_scaling --chain [N ...], --tree [N ...]  the chain or the tree instead of the four-bar
 //
 // Each N is run in a fresh process (this program re-executes itself with --one N), so that the
 // peak resident memory (getrusage ru_maxrss) is that of the one size. The model is built in code
@@ -58,20 +60,22 @@ double cpu_now() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
+// A slender rod of 1 m and 1 kg along its x axis, with the named point at its far end.
+BodySpec slender_rod(const std::string& name, const std::string& end) {
+  BodySpec b;
+  b.name = name;
+  b.mass = 1;
+  b.com = Vec3(0.5, 0, 0);
+  b.inertia = Vec3(0, 1.0 / 12, 1.0 / 12).asDiagonal();
+  b.points[end] = Vec3(1, 0, 0);
+  return b;
+}
+
 // A02 N four-bar with all cranks at `theta` (couplers horizontal).
 Model four_bar(int n, double theta) {
   Model m;
   m.name = "A02_n_four_bar_N" + std::to_string(n);
   m.gravity = Vec3(0, -9.81, 0);
-  auto rod = [](const std::string& name, const std::string& end) {
-    BodySpec b;
-    b.name = name;
-    b.mass = 1;
-    b.com = Vec3(0.5, 0, 0);
-    b.inertia = Vec3(0, 1.0 / 12, 1.0 / 12).asDiagonal();
-    b.points[end] = Vec3(1, 0, 0);
-    return b;
-  };
   auto revolute = [&](const std::string& name, const std::string& parent, const std::string& child,
                       const std::string& coordinate, double value) {
     JointSpec j;
@@ -90,13 +94,13 @@ Model four_bar(int n, double theta) {
     return j;
   };
   for (int i = 0; i <= n; ++i) {
-    m.bodies.push_back(rod("crank" + std::to_string(i), "tip"));
+    m.bodies.push_back(slender_rod("crank" + std::to_string(i), "tip"));
     JointSpec j = revolute("pivot" + std::to_string(i), kGround, "crank" + std::to_string(i), "th" + std::to_string(i), theta);
     j.anchor = Vec3(i, 0, 0);
     m.joints.push_back(j);
   }
   for (int i = 1; i <= n; ++i) {
-    m.bodies.push_back(rod("coupler" + std::to_string(i), "end"));
+    m.bodies.push_back(slender_rod("coupler" + std::to_string(i), "end"));
     JointSpec j = revolute("pin" + std::to_string(i), "crank" + std::to_string(i - 1), "coupler" + std::to_string(i),
                            "c" + std::to_string(i), -theta);
     j.anchor_point = "tip";
@@ -112,17 +116,6 @@ Model four_bar(int n, double theta) {
     m.cuts.push_back(c);
   }
   return m;
-}
-
-// A slender rod of 1 m and 1 kg along its x axis, with the named point at its far end.
-BodySpec slender_rod(const std::string& name, const std::string& end) {
-  BodySpec b;
-  b.name = name;
-  b.mass = 1;
-  b.com = Vec3(0.5, 0, 0);
-  b.inertia = Vec3(0, 1.0 / 12, 1.0 / 12).asDiagonal();
-  b.points[end] = Vec3(1, 0, 0);
-  return b;
 }
 
 // A revolute joint about z from parent (its point `at`, or the ground origin) to child.
@@ -145,33 +138,32 @@ JointSpec revolute_about_z(Model& m, const std::string& parent, const std::strin
   return j;
 }
 
-// Serial chain of n rods pinned end to end (first to ground), released from the horizontal:
-// a tree with no loops, n bodies, one joint each.
-Model serial_chain(int n) {
+// n rods, rod k pinned at the tip of rod parent(k) (parent -1: the ground origin) at the
+// relative angle angle(k), released at rest.
+template <class Parent, class Angle>
+Model pinned_rods(const std::string& name, int n, Parent parent, Angle angle) {
   Model m;
-  m.name = "chain_N" + std::to_string(n);
+  m.name = name + "_N" + std::to_string(n);
   m.gravity = Vec3(0, -9.81, 0);
-  for (int i = 0; i < n; ++i) {
-    const std::string name = "link" + std::to_string(i);
-    m.bodies.push_back(slender_rod(name, "tip"));
-    m.joints.push_back(revolute_about_z(m, i ? "link" + std::to_string(i - 1) : kGround, i ? "tip" : "", name, 0.0));
+  for (int k = 0; k < n; ++k) {
+    const std::string rod = "rod" + std::to_string(k);
+    m.bodies.push_back(slender_rod(rod, "tip"));
+    const int p = parent(k);
+    m.joints.push_back(revolute_about_z(m, p >= 0 ? "rod" + std::to_string(p) : kGround, p >= 0 ? "tip" : "", rod, angle(k)));
   }
   return m;
+}
+
+// Serial chain of n rods pinned end to end (first to ground), released from the horizontal.
+Model serial_chain(int n) {
+  return pinned_rods("chain", n, [](int k) { return k - 1; }, [](int) { return 0.0; });
 }
 
 // Binary tree of n rods: rod k hangs from the tip of rod (k-1)/2 (rod 0 from ground), the two
 // children of a rod at +-0.3 rad relative to it, the root horizontal.
 Model binary_tree(int n) {
-  Model m;
-  m.name = "tree_N" + std::to_string(n);
-  m.gravity = Vec3(0, -9.81, 0);
-  for (int k = 0; k < n; ++k) {
-    const std::string name = "rod" + std::to_string(k);
-    m.bodies.push_back(slender_rod(name, "tip"));
-    const std::string parent = k ? "rod" + std::to_string((k - 1) / 2) : kGround;
-    m.joints.push_back(revolute_about_z(m, parent, k ? "tip" : "", name, k ? (k % 2 ? 0.3 : -0.3) : 0.0));
-  }
-  return m;
+  return pinned_rods("tree", n, [](int k) { return k ? (k - 1) / 2 : -1; },
+                     [](int k) { return k ? (k % 2 ? 0.3 : -0.3) : 0.0; });
 }
 
 enum class Topology { kFourBar, kChain, kTree };
@@ -453,6 +445,17 @@ int main(int argc, char** argv) {
       std::printf("%s N = %d done: %ld steps, %.3f s integration, setup QR %.3f s, nnz(L+U) %ld\n", topology_name(topo), n,
                   r.steps, r.integrate_s, r.qr_s, r.lu_nnz);
     std::fflush(stdout);
+  }
+
+  // Linear fill: nnz(L+U) per body may not double from one size to the next larger (at N^2 fill
+  // it grows with N: docs/scaling.md, chains before the KLU analysis choice).
+  for (size_t k = 1; k < results.size(); ++k) {
+    const Result &a = results[k - 1], &b = results[k];
+    if (a.n >= 100 && b.n > a.n && b.lu_nnz / double(b.bodies) > 2.0 * a.lu_nnz / double(a.bodies)) {
+      std::fprintf(stderr, "iftomm_scaling: nnz(L+U) per body %.0f at N = %d, %.0f at N = %d: not linear\n",
+                   a.lu_nnz / double(a.bodies), a.n, b.lu_nnz / double(b.bodies), b.n);
+      return 2;
+    }
   }
 
   std::vector<double> xs, per_step, per_res, per_jac, per_klu, per_fresh, qr, build, mem;
