@@ -49,6 +49,16 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
     cl.error_estimate = true;
     return "";
   }
+  if (a == "--animation") {
+    cl.animation = true;
+    return "";
+  }
+  if (a == "--animation-rate" && has_value) {
+    cl.animation = true;
+    const std::string why = read_number(a, args[++i], cl.animation_rate);
+    if (!why.empty() || cl.animation_rate > 0) return why;
+    return a + ": must be a positive number of frames per second, got '" + args[i] + "'";
+  }
   if (a == "--quiet") {
     opt.verbose = opt.progress = false;
     return "";
@@ -62,7 +72,7 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
 void print_usage() {
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
-               "                  [--output-step DT]\n"
+               "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation index3|index2-ggl|index1|penalty]\n"
                "       mbdae check SCENE.yaml\n");
 }

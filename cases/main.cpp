@@ -5,9 +5,11 @@
 // or resource failure (a file that cannot be written, a folder in use, out of memory),
 // 128 + N stopped by signal N (SIGINT 130, SIGTERM 143).
 #include <cstdio>
+#include <memory>
 #include <new>
 #include <string>
 
+#include "cases/animation_sink.h"
 #include "cases/cli_options.h"
 #include "cases/error_estimate.h"
 #include "cases/run_scene.h"
@@ -26,7 +28,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   mbdae::RunOptions& opt = cl.options;
-  opt.stop = mbdae::install_stop_signals();
+  if (!cl.check_only) opt.stop = mbdae::install_stop_signals();  // check: Ctrl-C ends it at once
   try {
     const mbdae::Scene scene = mbdae::load_scene(cl.scene_path);
     if (cl.check_only) {
@@ -40,7 +42,12 @@ int main(int argc, char** argv) {
     if (!bad_overrides.empty()) return 1;
     const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(opt.out_dir, {"results.csv", "summary.json"});
     if (cl.error_estimate || mbdae::error_estimate_requested(scene)) return mbdae::run_with_error_estimate(scene, opt);
-    const mbdae::RunOutcome r = mbdae::run_scene(scene, opt);
+    std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/animation_sink.h)
+    if (cl.animation || scene.animation.write)
+      anim = std::make_unique<mbdae::AnimationSink>(scene, opt.out_dir, cl.animation_rate);
+    std::vector<mbdae::Sink*> sinks;
+    if (anim) sinks.push_back(anim.get());
+    const mbdae::Result r = mbdae::run(scene, opt, sinks);
     const bool interrupted = r.summary.value("status", std::string()) == "interrupted";
     return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;
   } catch (const mbdae::SceneError& e) {

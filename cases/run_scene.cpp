@@ -10,6 +10,7 @@
 
 #include "cases/failure_diagnosis.h"
 #include "core/errors.h"
+#include "core/finite_check.h"
 #include "core/ida_driver.h"
 #include "core/output.h"
 #include "formulation/analyses.h"
@@ -391,6 +392,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& opt, const std::vecto
           first_sample = false;
           row[0] = t;
           for (size_t c = 0; c < column_sensors.size(); ++c) row[c + 1] = sensors[column_sensors[c]];
+          if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
+            throw non_finite_error("sensor " + out.columns[k], row[k], t);  // the driver stops the run
           if (!opt.out_dir.empty()) {
             try {
               csv.row(row.data());

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "cases/animation_spec.h"
 #include "formulation/model.h"
 
 namespace mbdae {
@@ -50,6 +51,7 @@ struct Scene {
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
   std::string redundant_constraints = "remove";  // or "fail"
+  AnimationSpec animation;  // cases/animation_spec.h
   // What the scene was read from (null for a scene built in code), for set_parameter.
   std::shared_ptr<const SceneSource> source;
 };

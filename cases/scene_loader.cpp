@@ -487,7 +487,8 @@ struct Loader {
   }
 
   void cut(const YAML::Node& n, Model& m) {
-    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "distance"};
+    static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "axis1", "axis2", "ref1", "ref2",
+                                   "distance"};
     if (!check_keys(n, "cut", general)) return;
     CutSpec c;
     c.where = where(n);
@@ -506,9 +507,10 @@ struct Loader {
     else if (type == "weld") c.type = CutSpec::Type::kWeld;
     else if (type == "distance") c.type = CutSpec::Type::kDistance;
     else if (!type.empty()) error(n["type"], "type", "unknown cut type " + quote(type) + " (ball, revolute, universal, prismatic, weld, distance)");
-    if (type == "ball" || type == "weld") applies(n, "a " + type + " cut", general, base);
+    if (type == "ball") applies(n, "a ball cut", general, base);
     if (type == "revolute" || type == "universal") applies(n, "a " + type + " cut", general, with({"axis1", "axis2"}));
-    if (type == "prismatic") applies(n, "a prismatic cut", general, with({"axis1"}));
+    if (type == "weld" || type == "prismatic")
+      applies(n, "a " + type + " cut", general, with({"axis1", "axis2", "ref1", "ref2"}));
     if (type == "distance") applies(n, "a distance cut", general, with({"distance"}));
     c.body1 = name(n, "body1");
     c.body2 = name(n, "body2");
@@ -518,6 +520,10 @@ struct Loader {
     c.axis2 = vec3(n, "axis2", c.axis1);
     if (c.axis1.norm() == 0) error(at(n, "axis1"), "axis1", "must not be zero");
     if (has(n, "axis2") && c.axis2.norm() == 0) error(at(n, "axis2"), "axis2", "must not be zero");
+    c.ref1 = vec3(n, "ref1", Vec3::Zero());
+    c.ref2 = vec3(n, "ref2", c.ref1);
+    if (has(n, "ref1") && c.ref1.norm() == 0) error(at(n, "ref1"), "ref1", "must not be zero");
+    if (has(n, "ref2") && c.ref2.norm() == 0) error(at(n, "ref2"), "ref2", "must not be zero");
     if (c.type == CutSpec::Type::kDistance) {
       const auto d = opt_number(n, "distance", true);
       c.distance = d.value_or(0.0);
@@ -874,6 +880,55 @@ struct Loader {
     return s;
   }
 
+  // The `animation` section (cases/animation_spec.h), from the model file or the scene.
+  void animation(const YAML::Node& n, AnimationSpec& a) {
+    if (!check_keys(n, "animation", {"write", "frame_rate", "max_frames", "start", "end", "axis_length", "shapes"}))
+      return;
+    if (has(n, "write")) {
+      const std::string v = text(n, "write", "false");
+      if (v != "true" && v != "false") error(n["write"], "write", "expected true or false, got " + quote(v));
+      a.write = v == "true";
+    }
+    auto positive = [&](const char* key, double& x, bool zero_ok) {
+      const auto v = opt_number(n, key);
+      if (v && (zero_ok ? *v >= 0 : *v > 0)) x = *v;
+      else if (v) error(n[key], key, std::string("must be ") + (zero_ok ? "zero or positive" : "positive") + ", got " + format_number(*v));
+    };
+    positive("frame_rate", a.frame_rate, false);
+    positive("axis_length", a.axis_length, true);
+    if (const auto m = opt_number(n, "max_frames")) {
+      if (*m >= 2 && *m <= 1e7 && std::floor(*m) == *m) a.max_frames = static_cast<int>(*m);
+      else error(n["max_frames"], "max_frames", "expected a whole number from 2 to 1e7, got " + format_number(*m));
+    }
+    a.start = opt_number(n, "start").value_or(a.start);
+    a.end = opt_number(n, "end").value_or(a.end);
+    if (!(a.end > a.start)) error(at(n, "end"), "end", "must exceed start");
+    if (!has(n, "shapes")) return;
+    if (!n["shapes"].IsSequence()) return error(n["shapes"], "shapes", "expected a list, got " + describe(n["shapes"]));
+    a.shapes.clear();
+    for (const auto& sn : n["shapes"]) {
+      if (!check_keys(sn, "shape", {"body", "type", "center", "axis", "size", "radius", "length"})) continue;
+      AnimationShape s;
+      s.where = where(sn);
+      s.body = name(sn, "body");
+      const std::string type = text(sn, "type", "", true);
+      s.center = vec3(sn, "center", s.center);
+      s.axis = vec3(sn, "axis", s.axis);
+      s.size = vec3(sn, "size", s.size, type == "box");
+      s.radius = number(sn, "radius", 0, type == "cylinder" || type == "sphere");
+      s.length = number(sn, "length", 0, type == "cylinder");
+      if (type == "box") s.type = AnimationShape::Type::kBox;
+      else if (type == "cylinder") s.type = AnimationShape::Type::kCylinder;
+      else if (type == "sphere") s.type = AnimationShape::Type::kSphere;
+      else if (has(sn, "type")) error(sn["type"], "type", "unknown shape " + quote(type) + " (box, cylinder, sphere)");
+      if (type == "box" && !(s.size.minCoeff() > 0)) error(at(sn, "size"), "size", "edge lengths must be positive");
+      if ((type == "cylinder" || type == "sphere") && !(s.radius > 0)) error(at(sn, "radius"), "radius", "must be positive");
+      if (type == "cylinder" && !(s.length > 0)) error(at(sn, "length"), "length", "must be positive");
+      if (!(s.axis.norm() > 0)) error(at(sn, "axis"), "axis", "must not be zero");
+      a.shapes.push_back(s);
+    }
+  }
+
   // Model sections: a model file, or the scene itself (`patch`: entries named like one of the
   // model replace it).
   void sections(const YAML::Node& root, Model& m, bool patch) {
@@ -1060,16 +1115,22 @@ bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, Field
     targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
   scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
                                           "forces", "sensors", "remove", "analysis", "output",
-                                          "redundant_constraints"});
+                                          "redundant_constraints", "animation"});
   if (mroot) {
     Loader model_loader{model_path, &issues, &lines};
     if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
-                                                  "forces", "sensors"}))
+                                                  "forces", "sensors", "animation"})) {
       model_loader.sections(*mroot, scene.model, false);
-    else
+      if (model_loader.has(*mroot, "animation")) model_loader.animation((*mroot)["animation"], scene.animation);
+    } else {
       complete = false;
+    }
   }
   scene_loader.sections(root, scene.model, true);
+  if (scene_loader.has(root, "animation")) scene_loader.animation(root["animation"], scene.animation);
+  for (const auto& shape : scene.animation.shapes)
+    if (std::none_of(scene.model.bodies.begin(), scene.model.bodies.end(), [&](const BodySpec& b) { return b.name == shape.body; }))
+      issues.push_back({shape.where.file, shape.where.line, "body", "animation shape on " + quote(shape.body) + ", which is not a body"});
   for (const std::string& name : scene_loader.names(root, "remove")) {
     bool found = false;
     auto drop = [&](auto& vec) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <cstdlib>
 #include <ctime>
 #include <numeric>
@@ -32,6 +33,7 @@ struct UserData {
   void* mem;
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
+  std::string callback_error;  // an exception of the problem's residual or Jacobian
   int non_finite = -1;         // a component of y found not finite by weights_fn
   double non_finite_value = 0;
 };
@@ -61,10 +63,20 @@ int weights_fn(N_Vector y, N_Vector w, void* ud) {
   return 0;
 }
 
+// No C++ exception may cross IDA's C frames: one from the problem's residual or Jacobian (a bug,
+// such as an assembly that does not repeat its pattern) is kept and IDA stopped (return -1).
+int callback_failed(UserData* u, const char* where, const std::exception& e) {
+  u->callback_error = std::string(where) + ": " + e.what();
+  return -1;
+}
+
 int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
   auto* u = static_cast<UserData*>(ud);
-  return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
-                              N_VGetArrayPointer(r));
+  try {
+    return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r));
+  } catch (const std::exception& e) {
+    return callback_failed(u, "residual", e);
+  }
 }
 
 int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix jac, void* ud,
@@ -76,8 +88,12 @@ int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector
   sunindextype* rowind = SUNSparseMatrix_IndexValues(jac);
   for (int c = 0; c <= p.cols; ++c) colptr[c] = p.colptr[c];
   for (int k = 0; k < p.nnz(); ++k) rowind[k] = p.rowind[k];
-  return u->problem->jacobian(t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
-                              SUNSparseMatrix_Data(jac));
+  try {
+    return u->problem->jacobian(t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
+                                SUNSparseMatrix_Data(jac));
+  } catch (const std::exception& e) {
+    return callback_failed(u, "Jacobian", e);
+  }
 }
 
 int root_fn(sunrealtype t, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
@@ -143,7 +159,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   SUNLinearSolver ls = make_klu_linear_solver(pattern, ctx);
   void* mem = IDACreate(ctx);
   UserData ud{&problem, &pattern, mem, o.rtol, o.atol,
-              o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0), ""};
+              o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0), "", "", -1, 0.0};
   const double h_cap = ud.h_initial;
   auto choose_initial_step = [&](double tt) {
     if (o.initial_step > 0) return;
@@ -278,6 +294,8 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
                                             ud.non_finite_value, tt);
       return fail(e.status, e.what(), tt);
     }
+    if (!ud.callback_error.empty())
+      return fail("internal_error", "the DAE's " + ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
     std::ostringstream os;
     double h = 0;
     IDAGetCurrentStep(mem, &h);

@@ -34,7 +34,6 @@ class KluSolver {
   double condest();
   int factorizations() const { return factorizations_; }
   int full_factorizations() const { return full_factorizations_; }
-  int status() const { return common_.status; }
   // Nonzeros of L + U (including the off-diagonal blocks of BTF) of the last factorization, and
   // the flop count of the last factorization (klu_flops); for the scaling benchmark.
   long factor_nnz() const;

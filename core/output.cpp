@@ -20,20 +20,18 @@ namespace {
 constexpr size_t kBufferBytes = 1 << 16;  // whole rows collected per write(2)
 
 // Test hook: MBDAE_OUTPUT_FAULT_BYTES=N makes every output file hold at most N bytes, as if the
-// file system were full (a write that crosses N writes up to N, then fails with ENOSPC).
+// file system were full (a write that crosses N writes up to N, then fails with ENOSPC). Read at
+// every write (one per 64 kB of rows), so that a test can set and clear it.
 long long fault_limit() {
-  static const long long limit = [] {
-    const char* s = std::getenv("MBDAE_OUTPUT_FAULT_BYTES");
-    return s && *s ? std::atoll(s) : -1LL;
-  }();
-  return limit;
+  const char* s = std::getenv("MBDAE_OUTPUT_FAULT_BYTES");
+  return s && *s ? std::atoll(s) : -1LL;
 }
 
 // Writes n bytes at the end of a file that holds `written` bytes; 0 or the errno of the failure.
 int write_all(int fd, const char* data, size_t n, long long written) {
+  const long long limit = fault_limit();
   while (n > 0) {
     size_t chunk = n;
-    const long long limit = fault_limit();
     if (limit >= 0) {
       if (written >= limit) return ENOSPC;
       chunk = static_cast<size_t>(std::min<long long>(static_cast<long long>(n), limit - written));
@@ -206,11 +204,12 @@ OutputFolderLock::OutputFolderLock(const std::string& dir) {
   if (fd_ < 0) throw OutputError("cannot lock output folder '" + dir + "' (" + path + ": " + os_error(errno) + ")");
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
+    if (err == ENOLCK || err == EOPNOTSUPP || err == ENOTSUP) return;  // a file system without locks: run unlocked
     char pid[32] = {0};
     const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
     ::close(fd_);
     fd_ = -1;
-    if (err == EWOULDBLOCK)
+    if (err == EWOULDBLOCK || err == EAGAIN)
       throw OutputError("output folder '" + dir + "' is in use by another run" +
                         (n > 0 ? " (process " + std::string(pid, static_cast<size_t>(n)) + ")" : std::string()) +
                         "; wait for it or choose another --out");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 namespace mbdae {
 
@@ -21,7 +22,7 @@ void SparseAssembler::finalize() {
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return tcols_[a] != tcols_[b] ? tcols_[a] < tcols_[b] : trows_[a] < trows_[b];
   });
-  slot_.assign(n, 0);
+  calls_.assign(n, Call{0, 0, 0});
   pattern_.colptr.assign(pattern_.cols + 1, 0);
   pattern_.rowind.clear();
   int last_r = -1, last_c = -1;
@@ -33,7 +34,7 @@ void SparseAssembler::finalize() {
       last_r = trows_[i];
       last_c = tcols_[i];
     }
-    slot_[i] = static_cast<int>(pattern_.rowind.size()) - 1;
+    calls_[i] = Call{trows_[i], tcols_[i], static_cast<int>(pattern_.rowind.size()) - 1};
   }
   for (int c = 0; c < pattern_.cols; ++c) pattern_.colptr[c + 1] += pattern_.colptr[c];
   trows_.clear();
@@ -46,7 +47,28 @@ void SparseAssembler::finalize() {
 void SparseAssembler::begin_values(double* values) {
   values_ = values;
   cursor_ = 0;
+  mismatch_.clear();
   std::fill(values, values + pattern_.nnz(), 0.0);
+}
+
+void SparseAssembler::mismatch(int row, int col) {
+  if (!mismatch_.empty()) return;  // the first one says it
+  mismatch_ = "add() call " + std::to_string(cursor_ + 1) + " of the value pass is at (" +
+              std::to_string(row) + ", " + std::to_string(col) + ")";
+  if (cursor_ < calls_.size())
+    mismatch_ += ", the recorded pattern has (" + std::to_string(calls_[cursor_].row) + ", " +
+                 std::to_string(calls_[cursor_].col) + ") there";
+  else
+    mismatch_ += ", beyond the " + std::to_string(calls_.size()) + " recorded calls";
+}
+
+void SparseAssembler::end_values() const {
+  if (!mismatch_.empty())
+    throw std::logic_error("sparse assembly does not repeat its recorded pattern: " + mismatch_);
+  if (cursor_ != calls_.size())
+    throw std::logic_error("sparse assembly does not repeat its recorded pattern: " +
+                           std::to_string(cursor_) + " add() calls in the value pass, " +
+                           std::to_string(calls_.size()) + " recorded");
 }
 
 void csc_multiply(const CscPattern& p, const double* values, const double* x, double* y) {

@@ -5,11 +5,12 @@
 // mapping the k-th add() call to its position in the value array. In value mode the same code
 // (making the same calls in the same order) writes values[slot[k]] += v: no search, no
 // allocation. Code that assembles must therefore call add() unconditionally, with zeros where
-// a term vanishes.
+// a term vanishes. Every value-pass call is checked against the recorded one (a bound and two
+// comparisons): a different call is never written anywhere, and end_values() reports it.
 #pragma once
 
-#include <cassert>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace mbdae {
@@ -36,17 +37,29 @@ class SparseAssembler {
       tcols_.push_back(col);
       return;
     }
-    assert(cursor_ < slot_.size());
-    values_[slot_[cursor_++]] += v;
+    if (cursor_ < calls_.size() && calls_[cursor_].row == row && calls_[cursor_].col == col) {
+      values_[calls_[cursor_++].slot] += v;
+      return;
+    }
+    mismatch(row, col);
   }
-  // Calls made in the last value pass must equal those recorded.
-  bool complete() const { return cursor_ == slot_.size(); }
+  // Whether the last value pass repeated the recorded calls exactly.
+  bool complete() const { return mismatch_.empty() && cursor_ == calls_.size(); }
+  // Ends a value pass: throws std::logic_error naming the first call that differs from the
+  // recorded pattern (a bug of the assembling code), or a pass with too few calls.
+  void end_values() const;
   const CscPattern& pattern() const { return pattern_; }
 
  private:
+  struct Call {
+    int row, col, slot;  // the recorded add() and its position in the value array
+  };
+  void mismatch(int row, int col);
   bool recording_ = false;
-  std::vector<int> trows_, tcols_, slot_;
+  std::vector<int> trows_, tcols_;
+  std::vector<Call> calls_;
   std::size_t cursor_ = 0;
+  std::string mismatch_;  // the first mismatching call of this value pass
   double* values_ = nullptr;
   CscPattern pattern_;
 };

@@ -5,6 +5,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/errors.h"
+#include "core/finite_check.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -33,23 +35,44 @@ void AugmentedSolver::assemble(const double* q, bool with_mass, double regulariz
   for (int i = 0; i < nc_; ++i) asm_.add(nq_ + i, nq_ + i, -regularization);
 }
 
+void AugmentedSolver::assemble_values(const double* q, bool with_mass, double regularization) {
+  asm_.begin_values(values_.data());
+  assemble(q, with_mass, regularization);
+  asm_.end_values();
+}
+
 bool AugmentedSolver::accelerations(const std::vector<char>& modes, const double* q,
                                     const double* v, double t, double* a, double* lambda) {
-  asm_.begin_values(values_.data());
-  assemble(q, true);
+  assemble_values(q, true);
+  check_overflow(values_.data(), static_cast<int>(values_.size()), t, "the mass matrix entries",
+                 "a mass or an inertia");
   if (!klu_.factor(values_.data())) return false;
   generalized_forces(sys_, modes, q, v, t, rhs_.data());
+  check_overflow(rhs_.data(), nq_, t, "the applied forces", "a mass, gravity or a force");
   constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
   if (!klu_.solve(rhs_.data())) return false;
+  check_overflow(rhs_.data(), nq_ + nc_, t, "the accelerations and constraint forces",
+                 "a force against a small mass or inertia");
   std::copy(rhs_.begin(), rhs_.begin() + nq_, a);
   if (lambda) std::copy(rhs_.begin() + nq_, rhs_.end(), lambda);
-  return std::all_of(rhs_.begin(), rhs_.end(), [](double x) { return std::isfinite(x); });
+  return true;
+}
+
+void AugmentedSolver::check_overflow(const double* x, int n, double t, const char* what,
+                                     const char* cause) const {
+  const int i = first_non_finite(x, n);
+  if (i < 0) return;
+  std::ostringstream os;
+  os << "overflow: " << what;
+  // The forces and the accelerations are per coordinate: name the body.
+  if (x == rhs_.data() && i < nq_) os << " of body " << sys_.bodies[i / 7].name;
+  os << " are not finite at t = " << t << " (" << cause << " too large for double precision?)";
+  throw SolveError("overflow", os.str());
 }
 
 bool AugmentedSolver::velocities(const double* q, double t, double* v) {
   // [I Phi_q^T; Phi_q 0] [dv; mu] = [0; -Phi_t - Phi_q v]
-  asm_.begin_values(values_.data());
-  assemble(q, false);
+  assemble_values(q, false);
   if (!klu_.factor(values_.data())) return false;
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
   constraint_rates(sys_, offsets_, q, v, t, rhs_.data() + nq_, nullptr);
@@ -61,8 +84,7 @@ bool AugmentedSolver::velocities(const double* q, double t, double* v) {
 }
 
 double AugmentedSolver::constraint_condition(const double* q) {
-  asm_.begin_values(values_.data());
-  assemble(q, false);
+  assemble_values(q, false);
   if (!klu_.factor(values_.data())) return INFINITY;
   return klu_.condest();
 }
@@ -78,8 +100,7 @@ PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, 
   for (res.iterations = 0; res.iterations < max_iter && norm > tol; ++res.iterations) {
     // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q -eps I] [dq; mu] = [0; -Phi]. With
     // eps > 0 (Levenberg-Marquardt) the step exists also for redundant constraints.
-    asm_.begin_values(values_.data());
-    assemble(q, false, regularization);
+    assemble_values(q, false, regularization);
     if (!klu_.factor(values_.data())) break;
     std::fill(rhs_.begin(), rhs_.begin() + nq_, 0.0);
     for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -phi[i];

@@ -25,21 +25,22 @@ struct PositionSolveResult {
 class AugmentedSolver {
  public:
   explicit AugmentedSolver(const System& sys);
-  // a (nq) and lambda (nc) at state (q, v, t).
+  // a (nq) and lambda (nc) at state (q, v, t). False if the matrix is singular; throws
+  // SolveError (status "overflow") if the mass matrix, the forces or the result are not finite.
   bool accelerations(const std::vector<char>& modes, const double* q, const double* v, double t,
                      double* a, double* lambda);
   bool velocities(const double* q, double t, double* v);
   PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100,
                                 double regularization = 0.0);
-  const std::vector<int>& offsets() const { return offsets_; }
-  int factorizations() const { return klu_.factorizations(); }
-  double last_rcond() { return klu_.rcond(); }
   // 1-norm condition estimate of [I Phi_q^T; Phi_q 0] at q: large near a singular configuration
   // (a lost or gained degree of freedom), about the ratio of extreme singular values of Phi_q.
   double constraint_condition(const double* q);
 
  private:
   void assemble(const double* q, bool with_mass, double regularization = 0.0);
+  // A value pass of assemble() into values_ (checked against the recorded pattern).
+  void assemble_values(const double* q, bool with_mass, double regularization = 0.0);
+  void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
   const System& sys_;
   std::vector<int> offsets_;
   int nq_, nc_;

@@ -99,9 +99,11 @@ void assemble_gamma_position_derivative_fd(const System& sys, const std::vector<
   Mat14 hp[3], hm[3];
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
-    // Hessians of norm and point rows are constant (A(p) s is quadratic in p): no third derivatives.
-    const bool constant_hessian =
-        c.type == Constraint::Type::kNorm || c.type == Constraint::Type::kPoint;
+    // Hessians of norm, point and orientation rows are constant (quadratic in p): no third
+    // derivatives.
+    const bool constant_hessian = c.type == Constraint::Type::kNorm ||
+                                  c.type == Constraint::Type::kPoint ||
+                                  c.type == Constraint::Type::kOrientation;
     const LocalState s = gather(q, c.bi, c.bj);
     const Vec14 x = to_vec(s), vl = gather_local(v, c.bi, c.bj);
     double d[3][14] = {};

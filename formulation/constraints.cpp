@@ -315,6 +315,36 @@ void coordinate_hessian(const Constraint& c, const LocalState& s, const double* 
   h += w[0] * coordinate_jet(c.coord, s).hess;
 }
 
+// kOrientation: (p_i (x) w).p_j = p_j^T R(w) p_i with R(w) p = p (x) w.
+Vec4 quaternion_product(const Vec4& a, const Vec4& b) {
+  Vec4 r;
+  r[0] = a[0] * b[0] - a.tail<3>().dot(b.tail<3>());
+  r.tail<3>() = a[0] * b.tail<3>() + b[0] * a.tail<3>() + a.tail<3>().cross(b.tail<3>());
+  return r;
+}
+Mat4 right_product_matrix(const Vec4& w) {
+  Mat4 m;
+  for (int a = 0; a < 4; ++a) m.col(a) = quaternion_product(Vec4::Unit(a), w);
+  return m;
+}
+void orientation_value(const Constraint& c, const LocalState& s, double, double* v) {
+  v[0] = quaternion_product(s.pi, c.w).dot(s.pj);
+}
+void orientation_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
+  const Mat4 r = right_product_matrix(c.w);
+  if (c.bi >= 0) rows[0].segment<4>(kPi4) = s.pj.transpose() * r;
+  if (c.bj >= 0) rows[0].segment<4>(kPj) = (r * s.pi).transpose();
+}
+void orientation_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
+  if (c.bi < 0 || c.bj < 0) return;  // linear in the one moving body's p
+  const Mat4 r = right_product_matrix(c.w);
+  h.block<4, 4>(kPi4, kPj) += w[0] * r.transpose();
+  h.block<4, 4>(kPj, kPi4) += w[0] * r;
+}
+void orientation_velocity(const Constraint& c, const LocalState& s, const LocalState& v, double* g) {
+  g[0] = c.bi < 0 || c.bj < 0 ? 0.0 : -2.0 * quaternion_product(v.pi, c.w).dot(v.pj);
+}
+
 struct Primitive {
   void (*value)(const Constraint&, const LocalState&, double t, double* v);
   void (*jacobian)(const Constraint&, const LocalState&, Row14* rows);  // rows zeroed before
@@ -331,8 +361,9 @@ const Primitive kPrimitives[] = {
     {dot2_value, dot2_jacobian, dot2_hessian, hessian_velocity_terms, true},
     {distance_value, distance_jacobian, distance_hessian, hessian_velocity_terms, true},
     {coordinate_value, coordinate_jacobian, coordinate_hessian, hessian_velocity_terms, false},
+    {orientation_value, orientation_jacobian, orientation_hessian, orientation_velocity, false},
 };
-static_assert(sizeof(kPrimitives) / sizeof(kPrimitives[0]) == 6, "one entry per Constraint::Type");
+static_assert(sizeof(kPrimitives) / sizeof(kPrimitives[0]) == 7, "one entry per Constraint::Type");
 
 const Primitive& primitive(const Constraint& c) { return kPrimitives[static_cast<int>(c.type)]; }
 
@@ -372,6 +403,15 @@ void constraint_gamma(const Constraint& c, const LocalState& s, const LocalState
 
 bool constraint_hessian_touches_r(const Constraint& c) {
   return primitive(c).hessian_touches_r || (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
+}
+
+void orientation_rows(const Vec4& c_i, const Vec4& c_j, Vec4 w[3]) {
+  const Vec4 cj_conj(c_j[0], -c_j[1], -c_j[2], -c_j[3]);
+  const Vec4 d = quaternion_product(c_i, cj_conj);
+  const Vec4 d_conj(d[0], -d[1], -d[2], -d[3]);
+  // Row k of the matrix of q -> conj(d) (x) q.
+  for (int k = 0; k < 3; ++k)
+    for (int b = 0; b < 4; ++b) w[k][b] = quaternion_product(d_conj, Vec4::Unit(b))[k + 1];
 }
 
 std::string row_label(const Constraint& c, int row) {

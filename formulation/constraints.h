@@ -14,6 +14,11 @@
 //   kDot2   (A_i a_i).(r_j + A_j s_j - r_i - A_i s_i) = 0           (point on a plane)
 //   kDistance |r_j + A_j s_j - r_i - A_i s_i|^2 - d^2 = 0
 //   kCoordinate  g(q) - f(t) = 0: a joint coordinate of a chain held (locked) or driven.
+//   kOrientation (p_i (x) w).p_j = 0: component k of the vector part of the Euler parameters
+//                conj(d) (x) conj(p_i) (x) p_j, with (x) the quaternion product and w the
+//                constant k-th row of the left-product matrix of conj(d). The three components
+//                vanish only where the relative rotation conj(p_i) (x) p_j equals the constant d
+//                (not at its 180-degree flips, unlike three dot-1 equations).
 #pragma once
 
 #include <string>
@@ -47,7 +52,7 @@ struct CoordinateFunction {
 };
 
 struct Constraint {
-  enum class Type { kNorm, kPoint, kDot1, kDot2, kDistance, kCoordinate };
+  enum class Type { kNorm, kPoint, kDot1, kDot2, kDistance, kCoordinate, kOrientation };
   // What the equation belongs to: a body's Euler-parameter norm, a tree joint, a loop cut, a
   // driven, locked or held (assembly, equilibrium) joint coordinate.
   enum class Owner { kNorm, kJoint, kCut, kDrive, kLock, kHold };
@@ -58,6 +63,7 @@ struct Constraint {
   Vec3 si = Vec3::Zero(), sj = Vec3::Zero();
   Vec3 ai = Vec3::Zero(), aj = Vec3::Zero();
   double distance = 0;
+  Vec4 w = Vec4::Zero();     // kOrientation: the row w (orientation_rows())
   CoordinateFunction coord;  // kCoordinate
   TimeFunction target;       // kCoordinate: f(t)
   std::string label;         // for messages, e.g. "joint rod2 (R1): parent y _|_ child x"
@@ -109,6 +115,10 @@ struct ScalarJet {
   Mat14 hess = Mat14::Zero();
 };
 ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s);
+
+// The three kOrientation rows w_k (k = x, y, z) that hold conj(p_i) (x) p_j = d, i.e. the
+// frames with Euler parameters c_i on body i and c_j on body j aligned, d = c_i (x) conj(c_j).
+void orientation_rows(const Vec4& c_i, const Vec4& c_j, Vec4 w[3]);
 
 // Wraps an angle difference into (-pi, pi].
 double wrap_angle(double a);

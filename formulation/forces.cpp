@@ -371,9 +371,9 @@ double force_switch_value(const Force& f, const LocalState& x, double t) {
   return f.type == ForceSpec::Type::kWheelContact ? contact(f, x, t, false).e : 0.0;
 }
 
-double force_length(const Force& f, const LocalState& x) {
+double force_length(const Force& f, const LocalState& x, double t) {
   switch (f.type) {
-    case ForceSpec::Type::kWheelContact: return contact(f, x, 0.0, false).e;
+    case ForceSpec::Type::kWheelContact: return contact(f, x, t, false).e;
     case ForceSpec::Type::kJointSpringDamper: return coordinate_jet(f.coordinate, x).value;
     case ForceSpec::Type::kTorque: return 0.0;
     case ForceSpec::Type::kBushing: {
@@ -421,7 +421,7 @@ double force_magnitude(const Force& f, const LocalState& x, const LocalState& v,
 double force_potential(const Force& f, const LocalState& x, double t, bool in_contact) {
   switch (f.type) {
     case ForceSpec::Type::kSpringDamper: {
-      const double stretch = force_length(f, x) - f.free_length;
+      const double stretch = force_length(f, x, t) - f.free_length;
       return 0.5 * f.stiffness * stretch * stretch;
     }
     case ForceSpec::Type::kWheelContact: {

@@ -85,8 +85,9 @@ double* force_parameter(Force& f, const std::string& parameter);  // nullptr if 
 bool force_has_switch(const Force& f);
 double force_switch_value(const Force& f, const LocalState& pos, double t);
 
-// Length and tension (or normal force) of an element, for sensors.
-double force_length(const Force& f, const LocalState& pos);
+// Length and tension (or normal force) of an element at time t, for sensors (a wheel contact's
+// length is its penetration, which depends on the ground height at t).
+double force_length(const Force& f, const LocalState& pos, double t);
 double force_magnitude(const Force& f, const LocalState& pos, const LocalState& vel, double t,
                        bool in_contact, const LoadInput* input = nullptr);
 // Potential energy stored in a conservative element (spring-damper, joint spring-damper,

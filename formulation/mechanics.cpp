@@ -220,7 +220,8 @@ static bool structurally_nonzero(const Constraint& c, int r, int l) {
   if (local >= 3) return c.type != Constraint::Type::kNorm || l < 7;
   switch (c.type) {
     case Constraint::Type::kNorm:
-    case Constraint::Type::kDot1: return false;
+    case Constraint::Type::kDot1:
+    case Constraint::Type::kOrientation: return false;
     case Constraint::Type::kCoordinate: return !c.coord.rotation;
     case Constraint::Type::kPoint: {
       int comp = -1;

@@ -61,6 +61,9 @@ struct CutSpec {
   Type type = Type::kBall;
   std::string body1, point1, body2, point2;
   Vec3 axis1 = Vec3::UnitZ(), axis2 = Vec3::UnitZ();  // body-frame axes (revolute: axis; ...)
+  // Weld, prismatic: reference directions that complete the cut frames (z = axis, x = ref made
+  // perpendicular to it); zero: the body axis most perpendicular to the cut's axis.
+  Vec3 ref1 = Vec3::Zero(), ref2 = Vec3::Zero();
   double distance = 0;                                 // kDistance
   SourceLocation where;
 };

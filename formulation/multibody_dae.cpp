@@ -37,6 +37,7 @@ int MultibodyDae::jacobian(double t_in, double cj, const double* y, const double
   newton_cj_ = cj;
   asm_.begin_values(values);
   assemble(input_time(t_in), cj, y, yp);
+  asm_.end_values();  // throws if the calls differ from the pattern's (the driver reports it)
   return 0;
 }
 
@@ -180,6 +181,9 @@ void MultibodyDae::after_step(double t_in, const double* y) {
 }
 
 void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, double* lambda) {
+  if (nq_ == 0)
+    throw SolveError("nothing_moves", "nothing moves: the scene has no body that can move (none, or all "
+                                      "welded or locked to ground), so there is nothing to integrate");
   const PositionSolveResult pr = aug_.positions(q, t, 1e-12);
   if (!pr.converged)
     throw SolveError("inconsistent_initial_state",

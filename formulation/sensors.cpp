@@ -76,7 +76,7 @@ SensorGradient force_sensor_gradient(const System& sys, const Sensor& s,
   const bool in_contact = modes[s.target];
   auto value = [&](const Vec14& x, const Vec14& xd) {
     return s.type == SensorSpec::Type::kForceLength
-               ? force_length(f, local_state(x))
+               ? force_length(f, local_state(x), t)
                : force_magnitude(f, local_state(x), local_state(xd), t, in_contact);
   };
   const Vec14 x = local_vector(gather(q, f.bi, f.bj)), xd = local_vector(gather(v, f.bi, f.bj));
@@ -163,7 +163,7 @@ double sensor_value(const System& sys, int k, const std::vector<char>& modes, co
     case SensorSpec::Type::kCoordinateRate: return coordinate_rate(sys, s.target, q, v);
     case SensorSpec::Type::kForceLength: {
       const Force& f = sys.forces[s.target];
-      return force_length(f, gather(q, f.bi, f.bj));
+      return force_length(f, gather(q, f.bi, f.bj), t);
     }
     case SensorSpec::Type::kForceValue: {
       const Force& f = sys.forces[s.target];

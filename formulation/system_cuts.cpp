@@ -1,20 +1,77 @@
 // Stage 4 of build_system(): each loop cut becomes the constraints of its type between the two
-// bodies' points and frames.
+// bodies' points and frames. Weld and prismatic cuts align two cut frames, one on each body
+// (z along axis1 / axis2, x along ref1 / ref2 made perpendicular to the axis), with the three
+// orientation equations of constraints.h, which hold exactly that relative rotation.
+#include <cmath>
+
 #include "formulation/system_build.h"
 
 namespace mbdae {
+namespace {
+
+// The two sides of a cut: each body's frame and the cut point (host-local coordinates).
+struct CutSides {
+  const BodyFrame* f1;
+  const BodyFrame* f2;
+  Vec3 s1, s2;
+};
+
+// The cut frame on one side, in its body's frame: z along `axis`, x along `ref` without its
+// component along the axis; a zero `ref` takes the body axis most perpendicular to `axis`.
+Mat3 cut_frame(const CutSpec& cut, const Vec3& axis, const Vec3& ref, const char* axis_field,
+               const char* ref_field) {
+  const Vec3 z = axis.normalized();
+  Vec3 r = ref;
+  if (r.isZero()) {
+    int k = 0;
+    for (int m = 1; m < 3; ++m)
+      if (std::fabs(z[m]) < std::fabs(z[k]) - 1e-12) k = m;
+    r = Vec3::Unit(k);
+  }
+  const Vec3 x = r - r.dot(z) * z;
+  if (x.norm() < 1e-6 * r.norm())
+    fail(cut.where, ref_field,
+         "cut '" + cut.name + "': " + ref_field + " is parallel to " + axis_field +
+             "; give a reference direction across the axis");
+  Mat3 f;
+  f.col(0) = x.normalized();
+  f.col(2) = z;
+  f.col(1) = z.cross(f.col(0));
+  return f;
+}
+
+Constraint cut_constraint(Constraint::Type type, const CutSides& s) {
+  Constraint c;
+  c.type = type;
+  c.bi = s.f1->body;
+  c.si = s.s1;
+  c.bj = s.f2->body;
+  c.sj = s.s2;
+  return c;
+}
+
+// The three equations that hold cut frame 1 on cut frame 2.
+template <class Add>
+void add_frame_alignment(const CutSpec& cut, const CutSides& s, Add add) {
+  const Mat3 c1 = s.f1->rotation * cut_frame(cut, cut.axis1, cut.ref1, "axis1", "ref1");
+  const Mat3 c2 = s.f2->rotation * cut_frame(cut, cut.axis2, cut.ref2, "axis2", "ref2");
+  Vec4 w[3];
+  orientation_rows(euler_parameters_from_rotation(c1), euler_parameters_from_rotation(c2), w);
+  for (int k = 0; k < 3; ++k) {
+    Constraint c = cut_constraint(Constraint::Type::kOrientation, s);
+    c.w = w[k];
+    add(c, std::string("frames aligned about ") + "xyz"[k]);
+  }
+}
+
+}  // namespace
 
 void add_cut_constraints(const ModelIndex& index, System& sys) {
-  const Model& model = index.model;
-  for (const auto& cut : model.cuts) {
-    // (pairs unpacked by hand: lambdas below capture them, which clang 14 refuses for
-    // structured bindings)
+  for (const auto& cut : index.model.cuts) {
     const auto p1 = point_of(index, sys, cut.body1, cut.point1, cut.where, "body1");
     const auto p2 = point_of(index, sys, cut.body2, cut.point2, cut.where, "body2");
-    const BodyFrame* f1 = p1.first;
-    const BodyFrame* f2 = p2.first;
-    const Vec3 s1 = p1.second, s2 = p2.second;
-    if (f1->body == f2->body)
+    const CutSides s{p1.first, p2.first, p1.second, p2.second};
+    if (s.f1->body == s.f2->body)
       fail(cut.where, "body2", "cut '" + cut.name + "' joins two parts of the same rigid body");
     auto add = [&](Constraint c, const std::string& what) {
       c.owner = Constraint::Owner::kCut;
@@ -22,68 +79,45 @@ void add_cut_constraints(const ModelIndex& index, System& sys) {
       c.label = "cut " + cut.name + ": " + what;
       sys.constraints.push_back(c);
     };
-    Constraint pt;
-    pt.type = Constraint::Type::kPoint;
-    pt.bi = f1->body;
-    pt.si = s1;
-    pt.bj = f2->body;
-    pt.sj = s2;
-    const Vec3 a1 = f1->local_vector(cut.axis1.normalized()), a2 = f2->local_vector(cut.axis2.normalized());
-    // Two unit vectors of body 2 perpendicular to its axis.
-    Vec3 n1 = a2.unitOrthogonal(), n2 = a2.cross(n1);
+    const Vec3 a1 = s.f1->local_vector(cut.axis1.normalized());
+    const Vec3 a2 = s.f2->local_vector(cut.axis2.normalized());
     auto dot1 = [&](const Vec3& u, const Vec3& w, const std::string& what) {
-      Constraint c;
-      c.type = Constraint::Type::kDot1;
-      c.bi = f1->body;
+      Constraint c = cut_constraint(Constraint::Type::kDot1, s);
       c.ai = u;
-      c.bj = f2->body;
       c.aj = w;
       add(c, what);
     };
+    const Constraint pt = cut_constraint(Constraint::Type::kPoint, s);
     switch (cut.type) {
       case CutSpec::Type::kBall: add(pt, "coincident points"); break;
-      case CutSpec::Type::kRevolute:
+      case CutSpec::Type::kRevolute: {
+        // Two unit vectors of body 2 perpendicular to its axis.
+        const Vec3 n1 = a2.unitOrthogonal(), n2 = a2.cross(n1);
         add(pt, "coincident points");
         dot1(a1, n1, "axis1 _|_ n1");
         dot1(a1, n2, "axis1 _|_ n2");
         break;
+      }
       case CutSpec::Type::kUniversal:
         add(pt, "coincident points");
         dot1(a1, a2, "axis1 _|_ axis2");
         break;
-      case CutSpec::Type::kWeld: {
+      case CutSpec::Type::kWeld:
         add(pt, "coincident points");
-        const Mat3 r1 = f1->rotation, r2 = f2->rotation;
-        dot1(r1.col(0), r2.col(1), "x1 _|_ y2");
-        dot1(r1.col(1), r2.col(2), "y1 _|_ z2");
-        dot1(r1.col(2), r2.col(0), "z1 _|_ x2");
+        add_frame_alignment(cut, s, add);
         break;
-      }
       case CutSpec::Type::kPrismatic: {
-        const Mat3 r1 = f1->rotation, r2 = f2->rotation;
-        dot1(r1.col(0), r2.col(1), "x1 _|_ y2");
-        dot1(r1.col(1), r2.col(2), "y1 _|_ z2");
-        dot1(r1.col(2), r2.col(0), "z1 _|_ x2");
+        add_frame_alignment(cut, s, add);
         const Vec3 m1 = a1.unitOrthogonal(), m2 = a1.cross(m1);
         for (const Vec3& m : {m1, m2}) {
-          Constraint c;
-          c.type = Constraint::Type::kDot2;
-          c.bi = f1->body;
+          Constraint c = cut_constraint(Constraint::Type::kDot2, s);
           c.ai = m;
-          c.si = s1;
-          c.bj = f2->body;
-          c.sj = s2;
           add(c, "no offset across the axis");
         }
         break;
       }
       case CutSpec::Type::kDistance: {
-        Constraint c;
-        c.type = Constraint::Type::kDistance;
-        c.bi = f1->body;
-        c.si = s1;
-        c.bj = f2->body;
-        c.sj = s2;
+        Constraint c = cut_constraint(Constraint::Type::kDistance, s);
         c.distance = cut.distance;
         add(c, "distance");
         break;

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "cases/scene.h"
+#include "cases/tests/run_command.h"
 #include "formulation/system.h"
 
 namespace fs = std::filesystem;
@@ -118,16 +119,9 @@ TEST_F(LoaderFiles, OutOfMemoryExitCode) {
   const fs::path p = dir / "bodies.yaml";
   std::ofstream(p) << big_scene(30000, 1);
   for (const std::string& command : {"check '" + p.string() + "'", "run '" + p.string() + "' --out '" + (dir / "out").string() + "' --quiet"}) {
-    const std::string cmd = "(ulimit -v 300000; exec '" + std::string(MBDAE_EXE) + "' " + command + ") 2>&1";
-    FILE* f = popen(cmd.c_str(), "r");
-    ASSERT_TRUE(f);
-    std::string out;
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), f)) > 0) out.append(buf.data(), n);
-    const int status = pclose(f);
-    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 4) << out;
-    EXPECT_NE(out.find("mbdae: out of memory"), std::string::npos) << out;
+    const auto r = test_support::run_command("ulimit -v 300000; exec '" + std::string(MBDAE_EXE) + "' " + command);
+    EXPECT_EQ(r.code, 4) << r.output;
+    EXPECT_NE(r.output.find("mbdae: out of memory"), std::string::npos) << r.output;
   }
 }
 

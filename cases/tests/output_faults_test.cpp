@@ -22,6 +22,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cases/tests/run_command.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -44,23 +46,8 @@ analysis:
   - {type: dynamics, t_end: T_END, output_step: 0.001}
 )";
 
-struct CliResult {
-  int code = -1;
-  std::string output;
-};
-
-// Runs a shell command line (stderr into the output); the exit code of the shell.
-CliResult shell(const std::string& cmd) {
-  CliResult r;
-  FILE* p = popen(("(" + cmd + ") 2>&1").c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using CliResult = mbdae::test_support::CommandResult;
+CliResult shell(const std::string& cmd) { return mbdae::test_support::run_command(cmd); }
 
 std::string sh_quote(const fs::path& p) { return "'" + p.string() + "'"; }
 std::string exe() { return std::string("'") + MBDAE_EXE + "'"; }
@@ -233,22 +220,25 @@ TEST_F(OutputFaults, ConcurrentRunsIntoOneFolder) {
   EXPECT_EQ(read_json(out / "summary.json")["status"], "interrupted");
 }
 
-// SIGTERM: the rows so far, a valid summary with status interrupted, exit 143; and a previous
-// run's summary is gone as soon as the new run starts.
-TEST_F(OutputFaults, SigtermDuringRun) {
-  fs::create_directories(out);
-  std::ofstream(out / "summary.json") << R"({"status": "ok"})";
-  const pid_t pid = start(scene("10000"), "run.log");
-  ASSERT_TRUE(wait_for_rows(50000));
-  EXPECT_FALSE(fs::exists(out / "summary.json"));  // the old "ok" is not left behind
-  kill(pid, SIGTERM);
-  EXPECT_EQ(wait_exit(pid), 128 + SIGTERM) << read_file(dir / "run.log");
-  const long rows = check_whole_rows(out / "results.csv");
-  const auto summary = read_json(out / "summary.json");
-  EXPECT_EQ(summary["status"], "interrupted");
-  EXPECT_EQ(summary["steps"][0]["statistics"]["output_rows"].get<long>(), rows);
-  EXPECT_LT(summary["steps"][0]["t_reached"].get<double>(), 10000.0);
-  EXPECT_FALSE(fs::exists(out / "results.csv.partial"));
+// SIGTERM and SIGINT: the rows so far, a valid summary with status interrupted, exit 128 + the
+// signal; and a previous run's summary is gone as soon as the new run starts.
+TEST_F(OutputFaults, SigtermAndSigintDuringRun) {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    fs::remove_all(out);
+    fs::create_directories(out);
+    std::ofstream(out / "summary.json") << R"({"status": "ok"})";
+    const pid_t pid = start(scene("10000"), "run.log");
+    ASSERT_TRUE(wait_for_rows(50000));
+    EXPECT_FALSE(fs::exists(out / "summary.json"));  // the old "ok" is not left behind
+    kill(pid, sig);
+    EXPECT_EQ(wait_exit(pid), 128 + sig) << read_file(dir / "run.log");
+    const long rows = check_whole_rows(out / "results.csv");
+    const auto summary = read_json(out / "summary.json");
+    EXPECT_EQ(summary["status"], "interrupted");
+    EXPECT_EQ(summary["steps"][0]["statistics"]["output_rows"].get<long>(), rows);
+    EXPECT_LT(summary["steps"][0]["t_reached"].get<double>(), 10000.0);
+    EXPECT_FALSE(fs::exists(out / "results.csv.partial"));
+  }
 }
 
 // SIGKILL at several moments: only whole rows on disk, no summary claiming anything.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cases/scene.h"
+#include "cases/tests/run_command.h"
 #include "core/errors.h"
 #include "formulation/system.h"
 
@@ -630,16 +631,8 @@ struct CliResult {
 };
 
 CliResult run(const std::string& args) {
-  CliResult r;
-  const std::string cmd = std::string("'") + MBDAE_EXE + "' " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  const auto r = test_support::run_command(std::string("'") + MBDAE_EXE + "' " + args);
+  return {r.code, r.output};
 }
 
 class Executable : public ::testing::Test {
