@@ -22,8 +22,6 @@ class KluSolver {
 
   // Symbolic analysis of the pattern (kept until analyze is called again).
   bool analyze(const CscPattern& pattern);
-  // Whether the symbolic analysis uses BTF (off after a fill fallback, see factor_fresh).
-  bool uses_btf() const { return common_.btf != 0; }
   // Numeric factorization of values on the analyzed pattern. False if singular.
   bool factor(const double* values);
   // Solves A x = b in place.
