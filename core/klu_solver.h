@@ -1,7 +1,8 @@
 // Sparse LU by SuiteSparse KLU: symbolic analysis once per pattern, numeric factorization
 // (klu_factor) the first time and klu_refactor (same pivot order) afterwards, falling back to a
 // fresh factorization when the reused pivots degrade (pivot ratio below 1e-14 and below 1e-3 of
-// the fresh one's).
+// the fresh one's). A fresh factorization whose fill exceeds twice the ordering's prediction
+// redoes the analysis without BTF once (KluSolver::factor_fresh).
 #pragma once
 
 #include <klu.h>
@@ -31,9 +32,15 @@ class KluSolver {
   double condest();
   int factorizations() const { return factorizations_; }
   int full_factorizations() const { return full_factorizations_; }
+  // Nonzeros of L + U (including the off-diagonal blocks of BTF) of the last factorization, and
+  // the flop count of the last factorization (klu_flops); for the scaling benchmark.
+  long factor_nnz() const;
+  double flops();
 
  private:
   void free_numeric();
+  bool analyze_pattern();
+  bool factor_fresh();
   klu_common common_;
   klu_symbolic* symbolic_ = nullptr;
   klu_numeric* numeric_ = nullptr;

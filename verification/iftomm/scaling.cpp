@@ -1,7 +1,9 @@
-// Scaling of mbdae with the size of the IFToMM A02 N four-bar mechanism (docs/scaling.md).
+// Scaling of mbdae with the size of the IFToMM A02 N four-bar mechanism, or (--chain, --tree)
+// of a serial chain or binary tree of the same rods, 0.05 s released at rest (docs/scaling.md).
 //
 //   iftomm_scaling [N ...]           default N = 10 100 1000 10000
 //   iftomm_scaling --markdown [N ...]  the same, as the markdown table of docs/scaling.md
+//   iftomm_scaling --chain [N ...], --tree [N ...]  the chain or the tree instead of the four-bar
 //
 // Each N is run in a fresh process (this program re-executes itself with --one N), so that the
 // peak resident memory (getrusage ru_maxrss) is that of the one size. The model is built in code
@@ -58,20 +60,22 @@ double cpu_now() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
+// A slender rod of 1 m and 1 kg along its x axis, with the named point at its far end.
+BodySpec slender_rod(const std::string& name, const std::string& end) {
+  BodySpec b;
+  b.name = name;
+  b.mass = 1;
+  b.com = Vec3(0.5, 0, 0);
+  b.inertia = Vec3(0, 1.0 / 12, 1.0 / 12).asDiagonal();
+  b.points[end] = Vec3(1, 0, 0);
+  return b;
+}
+
 // A02 N four-bar with all cranks at `theta` (couplers horizontal).
 Model four_bar(int n, double theta) {
   Model m;
   m.name = "A02_n_four_bar_N" + std::to_string(n);
   m.gravity = Vec3(0, -9.81, 0);
-  auto rod = [](const std::string& name, const std::string& end) {
-    BodySpec b;
-    b.name = name;
-    b.mass = 1;
-    b.com = Vec3(0.5, 0, 0);
-    b.inertia = Vec3(0, 1.0 / 12, 1.0 / 12).asDiagonal();
-    b.points[end] = Vec3(1, 0, 0);
-    return b;
-  };
   auto revolute = [&](const std::string& name, const std::string& parent, const std::string& child,
                       const std::string& coordinate, double value) {
     JointSpec j;
@@ -90,13 +94,13 @@ Model four_bar(int n, double theta) {
     return j;
   };
   for (int i = 0; i <= n; ++i) {
-    m.bodies.push_back(rod("crank" + std::to_string(i), "tip"));
+    m.bodies.push_back(slender_rod("crank" + std::to_string(i), "tip"));
     JointSpec j = revolute("pivot" + std::to_string(i), kGround, "crank" + std::to_string(i), "th" + std::to_string(i), theta);
     j.anchor = Vec3(i, 0, 0);
     m.joints.push_back(j);
   }
   for (int i = 1; i <= n; ++i) {
-    m.bodies.push_back(rod("coupler" + std::to_string(i), "end"));
+    m.bodies.push_back(slender_rod("coupler" + std::to_string(i), "end"));
     JointSpec j = revolute("pin" + std::to_string(i), "crank" + std::to_string(i - 1), "coupler" + std::to_string(i),
                            "c" + std::to_string(i), -theta);
     j.anchor_point = "tip";
@@ -113,6 +117,57 @@ Model four_bar(int n, double theta) {
   }
   return m;
 }
+
+// A revolute joint about z from parent (its point `at`, or the ground origin) to child.
+JointSpec revolute_about_z(Model& m, const std::string& parent, const std::string& at, const std::string& child,
+                           double angle) {
+  JointSpec j;
+  j.name = "pin_" + child;
+  j.parent = parent;
+  j.child = child;
+  if (!at.empty()) j.anchor_point = at;
+  ElementaryJoint e;
+  e.rotation = true;
+  e.axis = 2;
+  e.coordinate = "th_" + child;
+  j.chain.push_back(e);
+  CoordinateSpec c;
+  c.name = e.coordinate;
+  c.initial = angle;
+  m.coordinates[c.name] = c;
+  return j;
+}
+
+// n rods, rod k pinned at the tip of rod parent(k) (parent -1: the ground origin) at the
+// relative angle angle(k), released at rest.
+template <class Parent, class Angle>
+Model pinned_rods(const std::string& name, int n, Parent parent, Angle angle) {
+  Model m;
+  m.name = name + "_N" + std::to_string(n);
+  m.gravity = Vec3(0, -9.81, 0);
+  for (int k = 0; k < n; ++k) {
+    const std::string rod = "rod" + std::to_string(k);
+    m.bodies.push_back(slender_rod(rod, "tip"));
+    const int p = parent(k);
+    m.joints.push_back(revolute_about_z(m, p >= 0 ? "rod" + std::to_string(p) : kGround, p >= 0 ? "tip" : "", rod, angle(k)));
+  }
+  return m;
+}
+
+// Serial chain of n rods pinned end to end (first to ground), released from the horizontal.
+Model serial_chain(int n) {
+  return pinned_rods("chain", n, [](int k) { return k - 1; }, [](int) { return 0.0; });
+}
+
+// Binary tree of n rods: rod k hangs from the tip of rod (k-1)/2 (rod 0 from ground), the two
+// children of a rod at +-0.3 rad relative to it, the root horizontal.
+Model binary_tree(int n) {
+  return pinned_rods("tree", n, [](int k) { return k ? (k - 1) / 2 : -1; },
+                     [](int k) { return k ? (k % 2 ? 0.3 : -0.3) : 0.0; });
+}
+
+enum class Topology { kFourBar, kChain, kTree };
+const char* topology_name(Topology t) { return t == Topology::kFourBar ? "fourbar" : t == Topology::kChain ? "chain" : "tree"; }
 
 // Forwards to an Index3Dae, timing residual and Jacobian evaluations.
 class TimedDae : public DaeProblem {
@@ -132,6 +187,7 @@ class TimedDae : public DaeProblem {
     const int status = d_.jacobian(t, cj, y, yp, values);
     jacobian_seconds += cpu_now() - c0;
     ++jacobians;
+    if (first_y.empty()) first_t = t, first_cj = cj, first_y.assign(y, y + size()), first_yp.assign(yp, yp + size());
     last_t = t, last_cj = cj;
     last_y.assign(y, y + size());
     last_yp.assign(yp, yp + size());
@@ -155,15 +211,17 @@ class TimedDae : public DaeProblem {
 
   double residual_seconds = 0, jacobian_seconds = 0;
   long residuals = 0, jacobians = 0;
-  double last_t = 0, last_cj = 0;
-  std::vector<double> last_y, last_yp;
+  double last_t = 0, last_cj = 0, first_t = 0, first_cj = 0;
+  std::vector<double> last_y, last_yp, first_y, first_yp;
 
  private:
   Index3Dae& d_;
 };
 
 struct Result {
-  int n = 0;
+  int n = 0, topology = 0;
+  long lu_nnz = 0;  // nonzeros of L + U of KLU's factorization of the Newton matrix
+  double flops = 0;  // KLU's flop count of one factorization of it
   long bodies = 0, unknowns = 0, equations = 0, redundant = 0, jac_nnz = 0;
   double build_s = 0, project_s = 0, qr_s = 0, init_s = 0;
   long steps = 0, residuals = 0, jacobians = 0, setups = 0;
@@ -175,13 +233,15 @@ struct Result {
   bool ok = false;
 };
 
-Result run_one(int n) {
+Result run_one(int n, Topology topo) {
   Result res;
   res.n = n;
-  const double theta0 = kPi / 2, rate0 = -1.0, t_end = 0.5;
+  res.topology = static_cast<int>(topo);
+  const bool fb = topo == Topology::kFourBar;
+  const double theta0 = kPi / 2, rate0 = -1.0, t_end = fb ? 0.5 : 0.05;
 
   double c0 = cpu_now();
-  System sys = build_system(four_bar(n, theta0));
+  System sys = build_system(fb ? four_bar(n, theta0) : topo == Topology::kChain ? serial_chain(n) : binary_tree(n));
   res.build_s = cpu_now() - c0;
   res.bodies = sys.num_bodies();
 
@@ -210,7 +270,7 @@ Result run_one(int n) {
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(q.begin(), q.end(), y.begin());
   c0 = cpu_now();
-  solve_initial_velocities(sys, y.data(), 0.0, {{sys.coordinate_index("th0"), rate0}}, y.data() + sys.nq());
+  if (fb) solve_initial_velocities(sys, y.data(), 0.0, {{sys.coordinate_index("th0"), rate0}}, y.data() + sys.nq());
   dae.consistent_initial_values(0.0, y, yp);
   res.init_s = cpu_now() - c0;
 
@@ -233,10 +293,10 @@ Result run_one(int n) {
   res.residual_s = timed.residual_seconds;
   res.jacobian_s = timed.jacobian_seconds;
   res.max_violation = dae.max_position_violation;
-  res.theta_end = coordinate_value(sys, sys.coordinate_index("th0"), y.data());
+  if (fb) res.theta_end = coordinate_value(sys, sys.coordinate_index("th0"), y.data());
 
   // Reference theta(0.5) of M theta'' = -C cos(theta) (RK4, h = 1e-5).
-  {
+  if (fb) {
     const double big_m = (n + 1) / 3.0 + n, c = 9.81 * ((n + 1) / 2.0 + n);
     double th = theta0, w = rate0;
     const int steps = 50000;
@@ -251,23 +311,27 @@ Result run_one(int n) {
     res.theta_ref = th;
   }
 
-  // KLU on the Newton matrix of the last Jacobian evaluation, with mbdae's KluSolver as IDA uses
-  // it (core/klu_linear_solver.cpp): symbolic analysis once, a fresh klu_factor the first time,
-  // then klu_refactor with the same pivot order (KluSolver::factor). Averages over repeats.
+  // KLU with mbdae's KluSolver as IDA uses it (core/klu_linear_solver.cpp): symbolic analysis
+  // once, a fresh klu_factor of the first Newton matrix of the run (its pivot order is the one
+  // IDA keeps), then klu_refactor with that order on the Newton matrix of the last Jacobian
+  // evaluation (KluSolver::factor). Averages over repeats.
   if (timed.jacobians > 0) {
     std::vector<double> values(res.jac_nnz), b(dae.size(), 1.0);
-    dae.jacobian(timed.last_t, timed.last_cj, timed.last_y.data(), timed.last_yp.data(), values.data());
+    dae.jacobian(timed.first_t, timed.first_cj, timed.first_y.data(), timed.first_yp.data(), values.data());
     KluSolver klu;
     klu.analyze(dae.jacobian_pattern());
     c0 = cpu_now();
     klu.factor(values.data());
     res.klu_first_s = cpu_now() - c0;
-    res.rcond = klu.rcond();
-    const int reps = n >= 10000 ? 5 : n >= 1000 ? 20 : 200;
+    dae.jacobian(timed.last_t, timed.last_cj, timed.last_y.data(), timed.last_yp.data(), values.data());
+    res.lu_nnz = klu.factor_nnz();
+    res.flops = klu.flops();
+    const int reps = n >= 10000 ? 5 : n >= 1000 ? 20 : 200, fresh0 = klu.full_factorizations();
     c0 = cpu_now();
     for (int k = 0; k < reps; ++k) klu.factor(values.data());
     res.klu_refactor_s = (cpu_now() - c0) / reps;
-    res.fresh_in_repeats = klu.full_factorizations() - 1;
+    res.fresh_in_repeats = klu.full_factorizations() - fresh0;
+    res.rcond = klu.rcond();
     c0 = cpu_now();
     for (int k = 0; k < reps; ++k) klu.solve(b.data());
     res.klu_solve_s = (cpu_now() - c0) / reps;
@@ -280,11 +344,11 @@ Result run_one(int n) {
 
 void print_one(const Result& r) {
   std::printf(
-      "RESULT n=%d bodies=%ld unknowns=%ld equations=%ld redundant=%ld jac_nnz=%ld build=%.6g project=%.6g qr=%.6g "
+      "RESULT topo=%d n=%d lu_nnz=%ld flops=%.6g bodies=%ld unknowns=%ld equations=%ld redundant=%ld jac_nnz=%ld build=%.6g project=%.6g qr=%.6g "
       "init=%.6g ok=%d steps=%ld residuals=%ld jacobians=%ld setups=%ld integrate=%.6g residual=%.6g "
       "jacobian=%.6g klu_first=%.6g klu_refactor=%.6g klu_solve=%.6g rcond=%.6g fresh=%ld fresh_rep=%ld "
       "violation=%.3g theta_end=%.12g theta_ref=%.12g peak_kb=%ld\n",
-      r.n, r.bodies, r.unknowns, r.equations, r.redundant, r.jac_nnz, r.build_s, r.project_s, r.qr_s, r.init_s,
+      r.topology, r.n, r.lu_nnz, r.flops, r.bodies, r.unknowns, r.equations, r.redundant, r.jac_nnz, r.build_s, r.project_s, r.qr_s, r.init_s,
       r.ok ? 1 : 0, r.steps, r.residuals, r.jacobians, r.setups, r.integrate_s, r.residual_s, r.jacobian_s,
       r.klu_first_s, r.klu_refactor_s, r.klu_solve_s, r.rcond, r.fresh, r.fresh_in_repeats, r.max_violation,
       r.theta_end, r.theta_ref, r.peak_kb);
@@ -295,16 +359,16 @@ bool parse(const std::string& line, Result& r) {
   int ok = 0;
   const int got = std::sscanf(
       line.c_str(),
-      "RESULT n=%d bodies=%ld unknowns=%ld equations=%ld redundant=%ld jac_nnz=%ld build=%lf project=%lf qr=%lf "
+      "RESULT topo=%d n=%d lu_nnz=%ld flops=%lf bodies=%ld unknowns=%ld equations=%ld redundant=%ld jac_nnz=%ld build=%lf project=%lf qr=%lf "
       "init=%lf ok=%d steps=%ld residuals=%ld jacobians=%ld setups=%ld integrate=%lf residual=%lf "
       "jacobian=%lf klu_first=%lf klu_refactor=%lf klu_solve=%lf rcond=%lf fresh=%ld fresh_rep=%ld "
       "violation=%lf theta_end=%lf theta_ref=%lf peak_kb=%ld",
-      &r.n, &r.bodies, &r.unknowns, &r.equations, &r.redundant, &r.jac_nnz, &r.build_s, &r.project_s, &r.qr_s,
+      &r.topology, &r.n, &r.lu_nnz, &r.flops, &r.bodies, &r.unknowns, &r.equations, &r.redundant, &r.jac_nnz, &r.build_s, &r.project_s, &r.qr_s,
       &r.init_s, &ok, &r.steps, &r.residuals, &r.jacobians, &r.setups, &r.integrate_s, &r.residual_s,
       &r.jacobian_s, &r.klu_first_s, &r.klu_refactor_s, &r.klu_solve_s, &r.rcond, &r.fresh, &r.fresh_in_repeats,
       &r.max_violation, &r.theta_end, &r.theta_ref, &r.peak_kb);
   r.ok = ok != 0;
-  return got == 28;
+  return got == 31;
 }
 
 // Least-squares slope of log(y) against log(x).
@@ -322,17 +386,20 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 3 && std::strcmp(argv[1], "--one") == 0) {
-    print_one(run_one(std::atoi(argv[2])));
+  if (argc == 4 && std::strcmp(argv[1], "--one") == 0) {
+    print_one(run_one(std::atoi(argv[2]), static_cast<Topology>(std::atoi(argv[3]))));
     return 0;
   }
   bool markdown = false;
+  Topology topo = Topology::kFourBar;
   std::vector<int> sizes;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--markdown") == 0) markdown = true;
+    else if (std::strcmp(argv[k], "--chain") == 0) topo = Topology::kChain;
+    else if (std::strcmp(argv[k], "--tree") == 0) topo = Topology::kTree;
     else if (std::atoi(argv[k]) > 0) sizes.push_back(std::atoi(argv[k]));
     else {
-      std::fprintf(stderr, "usage: iftomm_scaling [--markdown] [N ...]\n");
+      std::fprintf(stderr, "usage: iftomm_scaling [--markdown] [--chain | --tree] [N ...]\n");
       return 1;
     }
   }
@@ -348,7 +415,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     self[len] = 0;
-    FILE* p = popen(("'" + std::string(self) + "' --one " + std::to_string(n)).c_str(), "r");
+    FILE* p = popen(("'" + std::string(self) + "' --one " + std::to_string(n) + " " +
+                     std::to_string(static_cast<int>(topo))).c_str(), "r");
     if (!p) return 1;
     char line[4096];
     Result r;
@@ -364,18 +432,31 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "iftomm_scaling: the integration for N = %d failed\n", n);
       return 2;
     }
-    if (r.redundant != 3L * n) {
-      std::fprintf(stderr, "iftomm_scaling: N = %d: %ld redundant equations, expected 3N = %d\n", n, r.redundant, 3 * n);
+    const bool fb = topo == Topology::kFourBar;
+    if (r.redundant != (fb ? 3L * n : 0L)) {
+      std::fprintf(stderr, "iftomm_scaling: N = %d: %ld redundant equations, expected %d\n", n, r.redundant, fb ? 3 * n : 0);
       return 2;
     }
-    if (std::fabs(r.theta_end - r.theta_ref) > 1e-3) {  // a sanity check at rtol 1e-6
+    if (fb && std::fabs(r.theta_end - r.theta_ref) > 1e-3) {  // a sanity check at rtol 1e-6
       std::fprintf(stderr, "iftomm_scaling: N = %d: theta(0.5) = %.9f, reference %.9f\n", n, r.theta_end, r.theta_ref);
       return 2;
     }
     results.push_back(r);
     if (!markdown)
-      std::printf("N = %d done: %ld steps, %.3f s integration, setup QR %.3f s\n", n, r.steps, r.integrate_s, r.qr_s);
+      std::printf("%s N = %d done: %ld steps, %.3f s integration, setup QR %.3f s, nnz(L+U) %ld\n", topology_name(topo), n,
+                  r.steps, r.integrate_s, r.qr_s, r.lu_nnz);
     std::fflush(stdout);
+  }
+
+  // Linear fill: nnz(L+U) per body may not double from one size to the next larger (at N^2 fill
+  // it grows with N: docs/scaling.md, chains before the KLU analysis choice).
+  for (size_t k = 1; k < results.size(); ++k) {
+    const Result &a = results[k - 1], &b = results[k];
+    if (a.n >= 100 && b.n > a.n && b.lu_nnz / double(b.bodies) > 2.0 * a.lu_nnz / double(a.bodies)) {
+      std::fprintf(stderr, "iftomm_scaling: nnz(L+U) per body %.0f at N = %d, %.0f at N = %d: not linear\n",
+                   a.lu_nnz / double(a.bodies), a.n, b.lu_nnz / double(b.bodies), b.n);
+      return 2;
+    }
   }
 
   std::vector<double> xs, per_step, per_res, per_jac, per_klu, per_fresh, qr, build, mem;
@@ -398,7 +479,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> head = {
       "N", "bodies", "unknowns", "Jacobian nnz", "redundant", "build_system s", "projection s", "SPQR s",
       "steps", "residuals", "Jacobians", "KLU factorizations (fresh)", "CPU s", "ms/step", "ms/residual",
-      "ms/Jacobian", "ms/KLU refactor", "ms/KLU fresh factor", "ms/KLU solve", "KLU rcond", "rest ms/step",
+      "ms/Jacobian", "us/step/body", "nnz(L+U)", "KLU Mflop/factor", "ms/KLU refactor", "ms/KLU fresh factor", "ms/KLU solve", "KLU rcond", "rest ms/step",
       "peak RSS MB",
       "theta(0.5) error"};
   std::vector<std::vector<std::string>> rows;
@@ -411,7 +492,8 @@ int main(int argc, char** argv) {
                     std::to_string(r.setups) + " (" + std::to_string(r.fresh) + ")",
                     fmt("%.3f", r.integrate_s), fmt("%.4g", 1e3 * r.integrate_s / r.steps),
                     fmt("%.4g", 1e3 * r.residual_s / r.residuals), fmt("%.4g", 1e3 * r.jacobian_s / r.jacobians),
-                    fmt("%.4g", 1e3 * r.klu_refactor_s), fmt("%.4g", 1e3 * r.klu_first_s),
+                    fmt("%.3g", 1e6 * r.integrate_s / r.steps / r.bodies), std::to_string(r.lu_nnz),
+                    fmt("%.3g", 1e-6 * r.flops), fmt("%.4g", 1e3 * r.klu_refactor_s), fmt("%.4g", 1e3 * r.klu_first_s),
                     fmt("%.4g", 1e3 * r.klu_solve_s), fmt("%.1e", r.rcond), fmt("%.4g", 1e3 * rest),
                     fmt("%.1f", r.peak_kb / 1024.0), fmt("%.1e", std::fabs(r.theta_end - r.theta_ref))});
   }
