@@ -25,19 +25,6 @@ void row_hessians(const Constraint& c, const LocalState& s, Mat14* h) {
   }
 }
 
-Vec14 to_vec(const LocalState& s) {
-  Vec14 x;
-  x << s.ri, s.pi, s.rj, s.pj;
-  return x;
-}
-LocalState to_state(const Vec14& x) {
-  LocalState s;
-  s.ri = x.head<3>();
-  s.pi = x.segment<4>(3);
-  s.rj = x.segment<3>(7);
-  s.pj = x.tail<4>();
-  return s;
-}
 
 }  // namespace
 
@@ -105,7 +92,7 @@ void assemble_gamma_position_derivative_fd(const System& sys, const std::vector<
                                   c.type == Constraint::Type::kPoint ||
                                   c.type == Constraint::Type::kOrientation;
     const LocalState s = gather(q, c.bi, c.bj);
-    const Vec14 x = to_vec(s), vl = gather_local(v, c.bi, c.bj);
+    const Vec14 x = local_vector(s), vl = gather_local(v, c.bi, c.bj);
     double d[3][14] = {};
     if (!constant_hessian && !a.recording()) {
       for (int l = 0; l < 14; ++l) {
@@ -114,8 +101,8 @@ void assemble_gamma_position_derivative_fd(const System& sys, const std::vector<
         Vec14 xp = x, xm = x;
         xp[l] += eps;
         xm[l] -= eps;
-        row_hessians(c, to_state(xp), hp);
-        row_hessians(c, to_state(xm), hm);
+        row_hessians(c, local_state(xp), hp);
+        row_hessians(c, local_state(xm), hm);
         for (int r = 0; r < c.rows(); ++r)
           d[r][l] = (vl.dot(hp[r] * vl) - vl.dot(hm[r] * vl)) / (2.0 * eps);
       }

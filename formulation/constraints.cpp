@@ -138,6 +138,21 @@ LocalState gather(const double* q, int bi, int bj) {
   return s;
 }
 
+Vec14 local_vector(const LocalState& s) {
+  Vec14 y;
+  y << s.ri, s.pi, s.rj, s.pj;
+  return y;
+}
+
+LocalState local_state(const Vec14& y) {
+  LocalState s;
+  s.ri = y.segment<3>(0);
+  s.pi = y.segment<4>(3);
+  s.rj = y.segment<3>(7);
+  s.pj = y.segment<4>(10);
+  return s;
+}
+
 Vec14 gather_local(const double* x, int bi, int bj) {
   Vec14 v = Vec14::Zero();
   if (bi >= 0) v.head<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bi);

@@ -79,6 +79,9 @@ struct LocalState {
 };
 LocalState gather(const double* q, int bi, int bj);
 Vec14 gather_local(const double* x, int bi, int bj);  // local 14-vector (zeros for ground)
+// A LocalState as the local 14-vector [ri, pi, rj, pj], and back.
+Vec14 local_vector(const LocalState& s);
+LocalState local_state(const Vec14& y);
 
 // Values of the constraint rows (1 or 3).
 void constraint_value(const Constraint& c, const LocalState& s, double t, double* value);

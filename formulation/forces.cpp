@@ -266,21 +266,6 @@ void bushing_eval(const Force& f, const LocalState& x, const LocalState& v, Vec1
 }
 }  // namespace
 
-Vec14 local_vector(const LocalState& s) {
-  Vec14 y;
-  y << s.ri, s.pi, s.rj, s.pj;
-  return y;
-}
-
-LocalState local_state(const Vec14& y) {
-  LocalState s;
-  s.ri = y.segment<3>(0);
-  s.pi = y.segment<4>(3);
-  s.rj = y.segment<3>(7);
-  s.pj = y.segment<4>(10);
-  return s;
-}
-
 const UserForceLaw* find_force_law(const std::string& name) {
   static const std::map<std::string, UserForceLaw> laws = builtin_laws();  // thread-safe initialization
   auto it = laws.find(name);

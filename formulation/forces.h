@@ -55,9 +55,6 @@ struct UserForceLaw {
 // The law named `name` from the immutable table in forces.cpp (safe from any thread), or null.
 const UserForceLaw* find_force_law(const std::string& name);
 
-// A local state as the 14-vector (r_i, p_i, r_j, p_j), and back.
-Vec14 local_vector(const LocalState& s);
-LocalState local_state(const Vec14& y);
 
 // Values of a load's expression components (index 0..2) and their derivatives with respect to
 // the positions and velocities of the bodies in Force::reads (7 columns per body, in order).
