@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "cases/field_ranges.h"
+#include "cases/analysis_types.h"
 #include "cases/scene.h"
 #include "cases/scene_overrides.h"
 #include "cases/scene_source.h"
@@ -769,25 +770,15 @@ struct Loader {
   AnalysisStep step(const YAML::Node& n) {
     AnalysisStep s;
     s.where = where(n);
-    static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
-                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
-                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
-                                   "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg", "initial_velocities"};
+    const Fields& general = analysis_fields();
     if (!check_keys(n, "analysis step", general)) return s;
     const std::string type = text(n, "type", "", true);
-    if (type == "assembly") s.type = AnalysisStep::Type::kAssembly;
-    else if (type == "equilibrium") s.type = AnalysisStep::Type::kEquilibrium;
-    else if (type == "kinematics") s.type = AnalysisStep::Type::kKinematics;
-    else if (type == "dynamics") s.type = AnalysisStep::Type::kDynamics;
-    else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (assembly, equilibrium, kinematics, dynamics)");
-    const bool integrates = s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics;
-    if (type == "assembly") applies(n, "an assembly step", general, {"type", "hold", "t0", "mode_check", "mode_check_deg"});
-    if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
-    if (integrates)
-      applies(n, "a " + type + " step", general,
-              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
-                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
-               "quiet_until", "quiet_sensors", "initial_velocities"});
+    const AnalysisType* kind = find_analysis_type(type);
+    if (kind) s.type = kind->type;
+    else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (" + analysis_type_names() + ")");
+    const bool integrates = kind && kind->integrates;
+    if (kind) applies(n, (std::string("aeiou").find(type[0]) == std::string::npos ? "a " : "an ") + type + " step", general,
+                      kind->fields);
     if (type == "kinematics" && has(n, "initial_velocities"))
       error(n["initial_velocities"], "initial_velocities",
             "does not apply to a kinematics step (its velocities follow from the drives)");
@@ -1157,7 +1148,7 @@ bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, Field
   }
   int integrations = 0;
   for (const auto& s : scene.steps)
-    if (s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics) ++integrations;
+    if (integrates(s)) ++integrations;
   if (integrations > 1) scene_loader.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
   scene.columns = scene_loader.names(root, "output");
   if (root["redundant_constraints"]) {
