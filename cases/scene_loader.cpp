@@ -597,6 +597,110 @@ struct Loader {
     else if (fr != "world" && n["frame"].IsScalar()) error(n["frame"], "frame", "expected world or body, got " + quote(fr));
   }
 
+  // Number fields of a force, checked as they are read.
+  void non_negative(const YAML::Node& n, const char* key, double& out, bool required) {
+    const auto x = opt_number(n, key, required);
+    if (x) out = *x;
+    if (x && *x < 0) error(n[key], key, "must not be negative, got " + format_number(*x));
+  }
+  void positive(const YAML::Node& n, const char* key, double& out) {
+    const auto x = opt_number(n, key, true);
+    if (x) out = *x;
+    if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
+  }
+  void two_points(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body1");
+    body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
+    f.body2 = name(n, "body2");
+    body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
+  }
+
+  // The fields of each force type (the table force_types() below lists the types).
+  void spring_damper(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    non_negative(n, "stiffness", f.stiffness, true);
+    non_negative(n, "damping", f.damping, false);
+    non_negative(n, "free_length", f.free_length, false);
+  }
+  void point_force(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+    frame(n, f);
+    load_component(n, "fx", f.fx, f.expression[0]);
+    load_component(n, "fy", f.fy, f.expression[1]);
+    load_component(n, "fz", f.fz, f.expression[2]);
+    force_parameters(n, f);
+  }
+  void torque(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    frame(n, f);
+    f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
+    if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+    if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
+    load_component(n, "torque", f.fx, f.expression[0]);
+    force_parameters(n, f);
+  }
+  void joint_spring_damper(const YAML::Node& n, ForceSpec& f) {
+    f.coordinate = name(n, "coordinate");
+    non_negative(n, "stiffness", f.stiffness, true);
+    non_negative(n, "damping", f.damping, false);
+    if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
+    if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
+    else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
+  }
+  void bushing(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
+      error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
+    three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
+    three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
+    three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
+    three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
+  }
+  void wheel_contact(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+    positive(n, "stiffness", f.stiffness);
+    positive(n, "radius", f.radius);
+    f.axis = vec3(n, "axis", Vec3::UnitY());
+    if (f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+    if (has(n, "ground")) f.ground = function(n["ground"], "ground");
+  }
+  void user_force(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    f.law = name(n, "law");
+    force_parameters(n, f);
+  }
+
+  struct ForceType {
+    const char* name;
+    ForceSpec::Type type;
+    Fields fields;  // the fields that apply to it
+    void (Loader::*read)(const YAML::Node&, ForceSpec&);
+  };
+  static const std::vector<ForceType>& force_types() {
+    using T = ForceSpec::Type;
+    static const std::vector<ForceType> table = {
+        {"spring_damper", T::kSpringDamper,
+         {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"},
+         &Loader::spring_damper},
+        {"point_force", T::kPointForce, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"},
+         &Loader::point_force},
+        {"torque", T::kTorque, {"name", "type", "body", "axis", "frame", "torque", "parameters"}, &Loader::torque},
+        {"joint_spring_damper", T::kJointSpringDamper,
+         {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"}, &Loader::joint_spring_damper},
+        {"bushing", T::kBushing,
+         {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "rotational_stiffness",
+          "rotational_damping"},
+         &Loader::bushing},
+        {"wheel_contact", T::kWheelContact, {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"},
+         &Loader::wheel_contact},
+        {"user", T::kUser, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"},
+         &Loader::user_force},
+    };
+    return table;
+  }
+
   void force(const YAML::Node& n, Model& m) {
     static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
                                    "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
@@ -607,92 +711,16 @@ struct Loader {
     f.where = where(n);
     f.name = name(n);
     const std::string type = text(n, "type", "", true);
-    auto non_negative = [&](const char* key, double& out, bool required) {
-      const auto x = opt_number(n, key, required);
-      if (x) out = *x;
-      if (x && *x < 0) error(n[key], key, "must not be negative, got " + format_number(*x));
-    };
-    auto positive = [&](const char* key, double& out) {
-      const auto x = opt_number(n, key, true);
-      if (x) out = *x;
-      if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
-    };
-    auto two_points = [&] {
-      f.body1 = name(n, "body1");
-      body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
-      f.body2 = name(n, "body2");
-      body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
-    };
-    if (type == "spring_damper") {
-      applies(n, "a spring_damper force", general,
-              {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"});
-      f.type = ForceSpec::Type::kSpringDamper;
-      two_points();
-      non_negative("stiffness", f.stiffness, true);
-      non_negative("damping", f.damping, false);
-      non_negative("free_length", f.free_length, false);
-    } else if (type == "point_force") {
-      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"});
-      f.type = ForceSpec::Type::kPointForce;
-      f.body1 = name(n, "body");
-      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
-      frame(n, f);
-      load_component(n, "fx", f.fx, f.expression[0]);
-      load_component(n, "fy", f.fy, f.expression[1]);
-      load_component(n, "fz", f.fz, f.expression[2]);
-      force_parameters(n, f);
-    } else if (type == "torque") {
-      applies(n, "a torque force", general, {"name", "type", "body", "axis", "frame", "torque", "parameters"});
-      f.type = ForceSpec::Type::kTorque;
-      f.body1 = name(n, "body");
-      frame(n, f);
-      f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
-      if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
-      if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
-      load_component(n, "torque", f.fx, f.expression[0]);
-      force_parameters(n, f);
-    } else if (type == "joint_spring_damper") {
-      applies(n, "a joint_spring_damper force", general,
-              {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"});
-      f.type = ForceSpec::Type::kJointSpringDamper;
-      f.coordinate = name(n, "coordinate");
-      non_negative("stiffness", f.stiffness, true);
-      non_negative("damping", f.damping, false);
-      if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
-      if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
-      else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
-    } else if (type == "bushing") {
-      applies(n, "a bushing force", general, {"name", "type", "body1", "point1", "body2", "point2", "stiffness",
-                                               "damping", "rotational_stiffness", "rotational_damping"});
-      f.type = ForceSpec::Type::kBushing;
-      two_points();
-      if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
-        error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
-      three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
-      three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
-      three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
-      three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
-    } else if (type == "wheel_contact") {
-      applies(n, "a wheel_contact force", general,
-              {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"});
-      f.type = ForceSpec::Type::kWheelContact;
-      f.body1 = name(n, "body");
-      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
-      positive("stiffness", f.stiffness);
-      positive("radius", f.radius);
-      f.axis = vec3(n, "axis", Vec3::UnitY());
-      if (f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
-      if (has(n, "ground")) f.ground = function(n["ground"], "ground");
-    } else if (type == "user") {
-      applies(n, "a user force", general, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"});
-      f.type = ForceSpec::Type::kUser;
-      two_points();
-      f.law = name(n, "law");
-      force_parameters(n, f);
+    const auto& types = force_types();
+    const auto it = std::find_if(types.begin(), types.end(), [&](const ForceType& t) { return type == t.name; });
+    if (it != types.end()) {
+      applies(n, "a " + type + " force", general, it->fields);
+      f.type = it->type;
+      (this->*(it->read))(n, f);
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown force type " + quote(type) +
-                                   " (spring_damper, point_force, torque, joint_spring_damper, bushing, "
-                                   "wheel_contact, user)");
+      std::string names;
+      for (const ForceType& t : types) names += (names.empty() ? "" : ", ") + std::string(t.name);
+      error(n["type"], "type", "unknown force type " + quote(type) + " (" + names + ")");
     }
     m.forces.push_back(f);
   }
