@@ -1093,62 +1093,37 @@ std::optional<YAML::Node> parse(const std::string& text, const std::string& path
   }
 }
 
-// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
-// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
-// the scene could not be read far enough to be validated.
-bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
-          std::vector<OverrideTarget>& targets) {
-  const std::string& path = src.path;
-  const auto parsed = parse(src.text, path, issues);
-  if (!parsed) return false;
-  const YAML::Node root = *parsed;
-  Loader scene_loader{path, &issues, &lines};
-  if (!root.IsMap()) {
-    issues.push_back({path, Loader::line_of(root), "",
-                      root.IsNull() ? "the scene is empty" : "the scene must be a YAML mapping (field: value lines)"});
+// The model file the scene's `model` field names, parsed into `mroot` (read once: kept in
+// src.models). False when the field is empty or the file cannot be read or parsed.
+bool read_model_tree(SceneSource& src, Loader& l, const YAML::Node& root, std::vector<SceneIssue>& issues,
+                     std::optional<YAML::Node>& mroot, std::string& model_path) {
+  const std::string model = l.name(root, "model");
+  if (model.empty()) return false;
+  model_path = (std::filesystem::path(src.path).parent_path() / model).string();
+  std::string why;
+  auto known = src.models.find(model_path);
+  const auto model_text =
+      known != src.models.end() ? std::optional<std::string>(known->second) : read_text_file(model_path, why);
+  if (!model_text) l.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
+  else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
+  return mroot.has_value();
+}
+
+// The model file's sections (the scene's own are read after them and add to or patch them).
+bool load_model_sections(const YAML::Node& mroot, const std::string& model_path, Scene& scene,
+                         std::vector<SceneIssue>& issues, FieldLines& lines) {
+  Loader l{model_path, &issues, &lines};
+  if (!l.check_keys(mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts", "forces",
+                                     "sensors", "animation"}))
     return false;
-  }
-  lines.scene_root = scene_loader.where(root);
-  bool complete = true;
-  std::optional<YAML::Node> mroot;
-  std::string model_path;
-  if (scene_loader.has(root, "model")) {
-    const std::string model = scene_loader.name(root, "model");
-    if (model.empty()) {
-      complete = false;
-    } else {
-      model_path = (std::filesystem::path(path).parent_path() / model).string();
-      std::string why;
-      auto known = src.models.find(model_path);
-      const auto model_text = known != src.models.end() ? std::optional<std::string>(known->second)
-                                                        : read_text_file(model_path, why);
-      if (!model_text) scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
-      else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
-      if (!mroot) complete = false;
-    }
-  }
-  if (!complete && !src.overrides.empty()) return false;
-  for (const auto& [p, v] : src.overrides)
-    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
-  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
-                                          "forces", "sensors", "remove", "analysis", "output",
-                                          "redundant_constraints", "animation"});
-  if (mroot) {
-    Loader model_loader{model_path, &issues, &lines};
-    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
-                                                  "forces", "sensors", "animation"})) {
-      model_loader.sections(*mroot, scene.model, false);
-      if (model_loader.has(*mroot, "animation")) model_loader.animation((*mroot)["animation"], scene.animation);
-    } else {
-      complete = false;
-    }
-  }
-  scene_loader.sections(root, scene.model, true);
-  if (scene_loader.has(root, "animation")) scene_loader.animation(root["animation"], scene.animation);
-  for (const auto& shape : scene.animation.shapes)
-    if (std::none_of(scene.model.bodies.begin(), scene.model.bodies.end(), [&](const BodySpec& b) { return b.name == shape.body; }))
-      issues.push_back({shape.where.file, shape.where.line, "body", "animation shape on " + quote(shape.body) + ", which is not a body"});
-  for (const std::string& name : scene_loader.names(root, "remove")) {
+  l.sections(mroot, scene.model, false);
+  if (l.has(mroot, "animation")) l.animation(mroot["animation"], scene.animation);
+  return true;
+}
+
+// `remove`: forces, sensors and cuts of the model dropped by name.
+void remove_items(Loader& l, const YAML::Node& root, Model& m) {
+  for (const std::string& name : l.names(root, "remove")) {
     bool found = false;
     auto drop = [&](auto& vec) {
       for (auto it = vec.begin(); it != vec.end(); ++it)
@@ -1158,33 +1133,78 @@ bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, Field
           return;
         }
     };
-    drop(scene.model.forces);
-    drop(scene.model.sensors);
-    drop(scene.model.cuts);
-    if (!found) scene_loader.error(root["remove"], "remove", "nothing named " + quote(name) + " to remove (forces, sensors, cuts)");
+    drop(m.forces);
+    drop(m.sensors);
+    drop(m.cuts);
+    if (!found) l.error(root["remove"], "remove", "nothing named " + quote(name) + " to remove (forces, sensors, cuts)");
   }
-  if (scene_loader.has(root, "analysis")) {
+}
+
+// `analysis`: one step or a list of them, at most one of which integrates in time.
+void analysis_steps(Loader& l, const YAML::Node& root, Scene& scene) {
+  if (l.has(root, "analysis")) {
     const YAML::Node a = root["analysis"];
     if (a.IsSequence()) {
-      if (a.size() == 0) scene_loader.error(a, "analysis", "no analysis steps (assembly, equilibrium, kinematics or dynamics)");
-      for (const auto& s : a) scene.steps.push_back(scene_loader.step(s));
+      if (a.size() == 0) l.error(a, "analysis", "no analysis steps (assembly, equilibrium, kinematics or dynamics)");
+      for (const auto& s : a) scene.steps.push_back(l.step(s));
     } else {
-      scene.steps.push_back(scene_loader.step(a));
+      scene.steps.push_back(l.step(a));
     }
   } else {
-    scene_loader.error(root, "analysis", "missing (assembly, equilibrium, kinematics or dynamics steps)");
+    l.error(root, "analysis", "missing (assembly, equilibrium, kinematics or dynamics steps)");
   }
   int integrations = 0;
   for (const auto& s : scene.steps)
     if (integrates(s)) ++integrations;
-  if (integrations > 1) scene_loader.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
-  scene.columns = scene_loader.names(root, "output");
+  if (integrations > 1) l.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
+}
+
+// Animation shapes, output columns, the redundancy policy.
+void scene_options(Loader& l, const YAML::Node& root, Scene& scene, std::vector<SceneIssue>& issues) {
+  if (l.has(root, "animation")) l.animation(root["animation"], scene.animation);
+  for (const auto& shape : scene.animation.shapes)
+    if (std::none_of(scene.model.bodies.begin(), scene.model.bodies.end(),
+                     [&](const BodySpec& b) { return b.name == shape.body; }))
+      issues.push_back({shape.where.file, shape.where.line, "body",
+                        "animation shape on " + quote(shape.body) + ", which is not a body"});
+  scene.columns = l.names(root, "output");
   if (root["redundant_constraints"]) {
-    scene.redundant_constraints = scene_loader.text(root, "redundant_constraints", "remove");
+    scene.redundant_constraints = l.text(root, "redundant_constraints", "remove");
     if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail")
-      scene_loader.error(root["redundant_constraints"], "redundant_constraints",
-                         "expected remove or fail, got '" + scene.redundant_constraints + "'");
+      l.error(root["redundant_constraints"], "redundant_constraints",
+              "expected remove or fail, got '" + scene.redundant_constraints + "'");
   }
+}
+
+// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
+// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
+// the scene could not be read far enough to be validated.
+bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
+          std::vector<OverrideTarget>& targets) {
+  const std::string& path = src.path;
+  const auto parsed = parse(src.text, path, issues);
+  if (!parsed) return false;
+  const YAML::Node root = *parsed;
+  Loader l{path, &issues, &lines};
+  if (!root.IsMap()) {
+    issues.push_back({path, Loader::line_of(root), "",
+                      root.IsNull() ? "the scene is empty" : "the scene must be a YAML mapping (field: value lines)"});
+    return false;
+  }
+  lines.scene_root = l.where(root);
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
+  bool complete = !l.has(root, "model") || read_model_tree(src, l, root, issues, mroot, model_path);
+  if (!complete && !src.overrides.empty()) return false;
+  for (const auto& [p, v] : src.overrides)
+    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
+  l.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts", "forces",
+                               "sensors", "remove", "analysis", "output", "redundant_constraints", "animation"});
+  if (mroot && !load_model_sections(*mroot, model_path, scene, issues, lines)) complete = false;
+  l.sections(root, scene.model, true);
+  scene_options(l, root, scene, issues);
+  remove_items(l, root, scene.model);
+  analysis_steps(l, root, scene);
   return complete;
 }
 
