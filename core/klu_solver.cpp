@@ -55,7 +55,7 @@ bool KluSolver::factor_fresh() {
                         &common_);
   if (numeric_ == nullptr || common_.status != KLU_OK) return false;
   const double predicted = symbolic_->lnz + symbolic_->unz;
-  if (common_.btf && numeric_->lnz + numeric_->unz > 2 * predicted) {
+  if (common_.btf && numeric_->lnz + numeric_->unz > 1.5 * predicted) {
     common_.btf = 0;
     if (!analyze_pattern()) return false;
     return factor_fresh();
