@@ -26,6 +26,8 @@ class KluSolver {
   bool factor(const double* values);
   // Solves A x = b in place.
   bool solve(double* b);
+  // Whether a factorization is held (solve can be called).
+  bool factored() const { return numeric_ != nullptr; }
   // Reciprocal condition estimate of the last factorization.
   double rcond();
   // 1-norm condition number estimate of the last factorized matrix (klu_condest).

@@ -248,7 +248,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
       output_failure = buf;
     }
   }
-  if (output_failure.empty() && output_accelerations && !aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr)) {
+  if (output_failure.empty() && output_accelerations && !aug_.output_accelerations(modes, q.data(), v.data(), t, a.data(), output_acceleration_tolerance)) {
     std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the acceleration solve failed (singular augmented matrix)", t_in);
     output_failure = buf;
   }
