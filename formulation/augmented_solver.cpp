@@ -18,7 +18,6 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   assemble(sys.q0.data(), true);
   asm_.finalize();
   klu_.analyze(asm_.pattern());
-  klu_output_.analyze(asm_.pattern());
   values_.resize(asm_.pattern().nnz());
   rhs_.resize(n);
   work_.resize(n);
@@ -74,8 +73,13 @@ bool AugmentedSolver::solve_accelerations(KluSolver& klu, const std::vector<char
   return true;
 }
 
+void AugmentedSolver::prepare_output_accelerations() {
+  if (!output_prepared_) output_prepared_ = klu_output_.analyze(asm_.pattern());
+}
+
 bool AugmentedSolver::output_accelerations(const std::vector<char>& modes, const double* q,
                                            const double* v, double t, double* a, double tolerance) {
+  if (!output_prepared_) return accelerations(modes, q, v, t, a, nullptr);
   if (history_size_ > 0 && !(t > history_t_[0])) history_size_ = 0;
   bool refined = false;
   if (klu_output_.factored() && history_size_ > 0) {

@@ -39,6 +39,9 @@ class AugmentedSolver {
   bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,
                             double t, double* a, double tolerance);
   static constexpr int kMaxRefinements = 4;
+  // The analysis of that factorization's pattern, outside the step loop (MultibodyDae's
+  // consistent_state); until then output_accelerations is accelerations().
+  void prepare_output_accelerations();
   struct RefinementStats {  // how output samples were solved (tests, benchmarks)
     long refined = 0, direct = 0, corrections = 0;
   } refinement;
@@ -66,6 +69,7 @@ class AugmentedSolver {
   KluSolver klu_;
   std::vector<double> values_, rhs_, work_, work2_, trial_;
   KluSolver klu_output_;  // output samples' acceleration matrix K0
+  bool output_prepared_ = false;
   // The last output solutions [a; lambda] and their times (history_[0] the newest).
   int history_size_ = 0;
   double history_t_[3] = {0, 0, 0};

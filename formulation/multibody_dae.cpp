@@ -191,6 +191,7 @@ void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, d
                      "initial positions violate the constraints (max " + std::to_string(pr.residual) +
                          "): " + pr.worst);
   if (!aug_.velocities(q, t, v)) throw SolveError("singular", "velocity projection is singular");
+  if (output_accelerations) aug_.prepare_output_accelerations();
   if (!aug_.accelerations(modes, q, v, t, a, lambda))
     throw SolveError("singular",
                      "the augmented mass matrix is singular at t = " + std::to_string(t) +

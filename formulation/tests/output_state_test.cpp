@@ -59,6 +59,7 @@ TEST(OutputState, RefinedAccelerationsMatchTheDirectSolve) {
   AugmentedSolver(sys).positions(q.data(), 0.0, 1e-13, 50);
   sys = without_redundant_constraints(sys, find_redundant_constraints(sys, q.data(), 0.0));
   AugmentedSolver sampler(sys), direct(sys);
+  sampler.prepare_output_accelerations();
   const std::vector<char> modes(sys.forces.size(), 0);
   for (int i = 0; i < sys.nq(); ++i) v[i] = 2.0 * std::sin(1.0 + i);
   ASSERT_TRUE(direct.velocities(q.data(), 0.0, v.data()));
