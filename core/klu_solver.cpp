@@ -53,7 +53,7 @@ bool KluSolver::analyze_pattern() {
   return true;
 }
 
-// Fresh klu_factor. If partial pivoting filled L + U to more than twice the fill that the
+// Fresh klu_factor. If partial pivoting filled L + U to more than 1.5 times the fill that the
 // ordering predicted, the pivots have left the ordering's diagonal (BTF's maximum transversal
 // matched rows to columns that the fill-reducing order does not respect; docs/scaling.md): the
 // pattern is analyzed again without BTF, as AMD on the matrix's own diagonal, and factored again.
