@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "cases/analysis_types.h"
 #include "cases/field_ranges.h"
 
 namespace mbdae {
@@ -99,7 +100,7 @@ std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& o
   std::vector<std::string> out;
   if (!(opt.output_step > 0)) return out;
   for (const AnalysisStep& s : scene.steps) {
-    if (s.type != AnalysisStep::Type::kKinematics && s.type != AnalysisStep::Type::kDynamics) continue;
+    if (!integrates(s)) continue;
     const std::string why = output_step_range_error(opt.output_step, s.t0, s.t_end);
     if (!why.empty()) out.push_back("--output-step: " + why);
   }

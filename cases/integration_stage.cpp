@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cases/analysis_types.h"
 #include "cases/failure_diagnosis.h"
 #include "cases/run_stages.h"
 #include "cases/step_tolerances.h"
@@ -226,7 +227,7 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
 
 bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
-  js["type"] = step.type == AnalysisStep::Type::kKinematics ? "kinematics" : "dynamics";
+  js["type"] = analysis_type(step.type).name;
   const std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
   const Formulation* f = find_formulation(name);
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",

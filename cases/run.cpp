@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cases/analysis_types.h"
 #include "cases/run_stages.h"
 #include "core/errors.h"
 #include "core/output.h"
@@ -183,13 +184,7 @@ namespace {
 
 bool run_step(RunContext& c, const AnalysisStep& step) {
   json js;
-  bool ok = false;
-  switch (step.type) {
-    case AnalysisStep::Type::kAssembly: ok = assembly_stage(c, step, js); break;
-    case AnalysisStep::Type::kEquilibrium: ok = equilibrium_stage(c, step, js); break;
-    case AnalysisStep::Type::kKinematics:
-    case AnalysisStep::Type::kDynamics: ok = integration_stage(c, step, js); break;
-  }
+  const bool ok = analysis_type(step.type).stage(c, step, js);
   if (ok) c.steps.push_back(js);
   return ok;
 }

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "cases/field_ranges.h"
+#include "cases/analysis_types.h"
 #include "cases/scene.h"
 #include "cases/scene_overrides.h"
 #include "cases/scene_source.h"
@@ -596,6 +597,110 @@ struct Loader {
     else if (fr != "world" && n["frame"].IsScalar()) error(n["frame"], "frame", "expected world or body, got " + quote(fr));
   }
 
+  // Number fields of a force, checked as they are read.
+  void non_negative(const YAML::Node& n, const char* key, double& out, bool required) {
+    const auto x = opt_number(n, key, required);
+    if (x) out = *x;
+    if (x && *x < 0) error(n[key], key, "must not be negative, got " + format_number(*x));
+  }
+  void positive(const YAML::Node& n, const char* key, double& out) {
+    const auto x = opt_number(n, key, true);
+    if (x) out = *x;
+    if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
+  }
+  void two_points(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body1");
+    body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
+    f.body2 = name(n, "body2");
+    body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
+  }
+
+  // The fields of each force type (the table force_types() below lists the types).
+  void spring_damper(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    non_negative(n, "stiffness", f.stiffness, true);
+    non_negative(n, "damping", f.damping, false);
+    non_negative(n, "free_length", f.free_length, false);
+  }
+  void point_force(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+    frame(n, f);
+    load_component(n, "fx", f.fx, f.expression[0]);
+    load_component(n, "fy", f.fy, f.expression[1]);
+    load_component(n, "fz", f.fz, f.expression[2]);
+    force_parameters(n, f);
+  }
+  void torque(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    frame(n, f);
+    f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
+    if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+    if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
+    load_component(n, "torque", f.fx, f.expression[0]);
+    force_parameters(n, f);
+  }
+  void joint_spring_damper(const YAML::Node& n, ForceSpec& f) {
+    f.coordinate = name(n, "coordinate");
+    non_negative(n, "stiffness", f.stiffness, true);
+    non_negative(n, "damping", f.damping, false);
+    if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
+    if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
+    else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
+  }
+  void bushing(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
+      error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
+    three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
+    three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
+    three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
+    three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
+  }
+  void wheel_contact(const YAML::Node& n, ForceSpec& f) {
+    f.body1 = name(n, "body");
+    body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+    positive(n, "stiffness", f.stiffness);
+    positive(n, "radius", f.radius);
+    f.axis = vec3(n, "axis", Vec3::UnitY());
+    if (f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
+    if (has(n, "ground")) f.ground = function(n["ground"], "ground");
+  }
+  void user_force(const YAML::Node& n, ForceSpec& f) {
+    two_points(n, f);
+    f.law = name(n, "law");
+    force_parameters(n, f);
+  }
+
+  struct ForceType {
+    const char* name;
+    ForceSpec::Type type;
+    Fields fields;  // the fields that apply to it
+    void (Loader::*read)(const YAML::Node&, ForceSpec&);
+  };
+  static const std::vector<ForceType>& force_types() {
+    using T = ForceSpec::Type;
+    static const std::vector<ForceType> table = {
+        {"spring_damper", T::kSpringDamper,
+         {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"},
+         &Loader::spring_damper},
+        {"point_force", T::kPointForce, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"},
+         &Loader::point_force},
+        {"torque", T::kTorque, {"name", "type", "body", "axis", "frame", "torque", "parameters"}, &Loader::torque},
+        {"joint_spring_damper", T::kJointSpringDamper,
+         {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"}, &Loader::joint_spring_damper},
+        {"bushing", T::kBushing,
+         {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "rotational_stiffness",
+          "rotational_damping"},
+         &Loader::bushing},
+        {"wheel_contact", T::kWheelContact, {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"},
+         &Loader::wheel_contact},
+        {"user", T::kUser, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"},
+         &Loader::user_force},
+    };
+    return table;
+  }
+
   void force(const YAML::Node& n, Model& m) {
     static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
                                    "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
@@ -606,92 +711,16 @@ struct Loader {
     f.where = where(n);
     f.name = name(n);
     const std::string type = text(n, "type", "", true);
-    auto non_negative = [&](const char* key, double& out, bool required) {
-      const auto x = opt_number(n, key, required);
-      if (x) out = *x;
-      if (x && *x < 0) error(n[key], key, "must not be negative, got " + format_number(*x));
-    };
-    auto positive = [&](const char* key, double& out) {
-      const auto x = opt_number(n, key, true);
-      if (x) out = *x;
-      if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
-    };
-    auto two_points = [&] {
-      f.body1 = name(n, "body1");
-      body_point(n, "point1", f.point1, f.xyz1, f.at_xyz1);
-      f.body2 = name(n, "body2");
-      body_point(n, "point2", f.point2, f.xyz2, f.at_xyz2);
-    };
-    if (type == "spring_damper") {
-      applies(n, "a spring_damper force", general,
-              {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"});
-      f.type = ForceSpec::Type::kSpringDamper;
-      two_points();
-      non_negative("stiffness", f.stiffness, true);
-      non_negative("damping", f.damping, false);
-      non_negative("free_length", f.free_length, false);
-    } else if (type == "point_force") {
-      applies(n, "a point_force force", general, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"});
-      f.type = ForceSpec::Type::kPointForce;
-      f.body1 = name(n, "body");
-      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
-      frame(n, f);
-      load_component(n, "fx", f.fx, f.expression[0]);
-      load_component(n, "fy", f.fy, f.expression[1]);
-      load_component(n, "fz", f.fz, f.expression[2]);
-      force_parameters(n, f);
-    } else if (type == "torque") {
-      applies(n, "a torque force", general, {"name", "type", "body", "axis", "frame", "torque", "parameters"});
-      f.type = ForceSpec::Type::kTorque;
-      f.body1 = name(n, "body");
-      frame(n, f);
-      f.axis = vec3(n, "axis", Vec3::UnitZ(), true);
-      if (has(n, "axis") && f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
-      if (!has(n, "torque")) error(n, "torque", "missing (a number, a function of time or an expression)");
-      load_component(n, "torque", f.fx, f.expression[0]);
-      force_parameters(n, f);
-    } else if (type == "joint_spring_damper") {
-      applies(n, "a joint_spring_damper force", general,
-              {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"});
-      f.type = ForceSpec::Type::kJointSpringDamper;
-      f.coordinate = name(n, "coordinate");
-      non_negative("stiffness", f.stiffness, true);
-      non_negative("damping", f.damping, false);
-      if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
-      if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
-      else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
-    } else if (type == "bushing") {
-      applies(n, "a bushing force", general, {"name", "type", "body1", "point1", "body2", "point2", "stiffness",
-                                               "damping", "rotational_stiffness", "rotational_damping"});
-      f.type = ForceSpec::Type::kBushing;
-      two_points();
-      if (!has(n, "stiffness") && !has(n, "rotational_stiffness"))
-        error(n, "stiffness", "missing (a bushing needs stiffness and/or rotational_stiffness, [x, y, z] each)");
-      three(n, "stiffness", f.translational_stiffness, "N/m per frame-1 axis");
-      three(n, "damping", f.translational_damping, "N s/m per frame-1 axis");
-      three(n, "rotational_stiffness", f.rotational_stiffness, "N m/rad per frame-1 axis");
-      three(n, "rotational_damping", f.rotational_damping, "N m s/rad per frame-1 axis");
-    } else if (type == "wheel_contact") {
-      applies(n, "a wheel_contact force", general,
-              {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"});
-      f.type = ForceSpec::Type::kWheelContact;
-      f.body1 = name(n, "body");
-      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
-      positive("stiffness", f.stiffness);
-      positive("radius", f.radius);
-      f.axis = vec3(n, "axis", Vec3::UnitY());
-      if (f.axis.norm() == 0) error(n["axis"], "axis", "must not be zero");
-      if (has(n, "ground")) f.ground = function(n["ground"], "ground");
-    } else if (type == "user") {
-      applies(n, "a user force", general, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"});
-      f.type = ForceSpec::Type::kUser;
-      two_points();
-      f.law = name(n, "law");
-      force_parameters(n, f);
+    const auto& types = force_types();
+    const auto it = std::find_if(types.begin(), types.end(), [&](const ForceType& t) { return type == t.name; });
+    if (it != types.end()) {
+      applies(n, "a " + type + " force", general, it->fields);
+      f.type = it->type;
+      (this->*(it->read))(n, f);
     } else if (!type.empty()) {
-      error(n["type"], "type", "unknown force type " + quote(type) +
-                                   " (spring_damper, point_force, torque, joint_spring_damper, bushing, "
-                                   "wheel_contact, user)");
+      std::string names;
+      for (const ForceType& t : types) names += (names.empty() ? "" : ", ") + std::string(t.name);
+      error(n["type"], "type", "unknown force type " + quote(type) + " (" + names + ")");
     }
     m.forces.push_back(f);
   }
@@ -766,77 +795,42 @@ struct Loader {
     m.sensors.push_back(s);
   }
 
-  AnalysisStep step(const YAML::Node& n) {
-    AnalysisStep s;
-    s.where = where(n);
-    static const Fields general = {"type", "hold", "release", "unknowns", "t0", "t_end", "output_step",
-                                   "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
-                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
-                                   "quiet_until", "quiet_sensors", "mode_check", "mode_check_deg", "initial_velocities"};
-    if (!check_keys(n, "analysis step", general)) return s;
-    const std::string type = text(n, "type", "", true);
-    if (type == "assembly") s.type = AnalysisStep::Type::kAssembly;
-    else if (type == "equilibrium") s.type = AnalysisStep::Type::kEquilibrium;
-    else if (type == "kinematics") s.type = AnalysisStep::Type::kKinematics;
-    else if (type == "dynamics") s.type = AnalysisStep::Type::kDynamics;
-    else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (assembly, equilibrium, kinematics, dynamics)");
-    const bool integrates = s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics;
-    if (type == "assembly") applies(n, "an assembly step", general, {"type", "hold", "t0", "mode_check", "mode_check_deg"});
-    if (type == "equilibrium") applies(n, "an equilibrium step", general, {"type", "hold", "release", "unknowns", "t0"});
-    if (integrates)
-      applies(n, "a " + type + " step", general,
-              {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation", "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "output_projection",
-                                   "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate",
-               "quiet_until", "quiet_sensors", "initial_velocities"});
-    if (type == "kinematics" && has(n, "initial_velocities"))
-      error(n["initial_velocities"], "initial_velocities",
-            "does not apply to a kinematics step (its velocities follow from the drives)");
-    if (has(n, "initial_velocities")) {
-      const YAML::Node iv = n["initial_velocities"];
-      record(n, "initial_velocities", iv);
-      if (!iv.IsMap()) {
-        error(iv, "initial_velocities", "expected a mapping of coordinate names to rates, got " + describe(iv));
-      } else {
-        for (const auto& kv : iv) {
-          const auto cname = key_of(kv.first, "initial_velocities");
-          if (!cname) continue;
-          if (const auto x = to_number(kv.second, "initial_velocities." + *cname))
-            s.initial_velocities.emplace_back(*cname, *x);
-        }
-      }
+  // `initial_velocities` of a dynamics step: coordinate names to rates.
+  void initial_velocities(const YAML::Node& n, const std::string& type, AnalysisStep& s) {
+    if (!has(n, "initial_velocities")) return;
+    const YAML::Node iv = n["initial_velocities"];
+    if (type == "kinematics")
+      error(iv, "initial_velocities", "does not apply to a kinematics step (its velocities follow from the drives)");
+    record(n, "initial_velocities", iv);
+    if (!iv.IsMap()) {
+      error(iv, "initial_velocities", "expected a mapping of coordinate names to rates, got " + describe(iv));
+      return;
     }
-    s.hold = names(n, "hold");
-    s.release = names(n, "release");
-    s.unknowns = names(n, "unknowns");
+    for (const auto& kv : iv) {
+      const auto cname = key_of(kv.first, "initial_velocities");
+      if (!cname) continue;
+      if (const auto x = to_number(kv.second, "initial_velocities." + *cname)) s.initial_velocities.emplace_back(*cname, *x);
+    }
+  }
+
+  // A true/false field.
+  void flag(const YAML::Node& n, const char* key, bool& out) {
+    if (!has(n, key)) return;
+    const std::string v = text(n, key, "false");
+    if (v == "true") out = true;
+    else if (v != "false") error(at(n, key), key, "expected true or false, got " + quote(v));
+  }
+
+  // The time span, tolerances and model scales of a step, each checked against its range.
+  void step_span_and_tolerances(const YAML::Node& n, bool integrates, AnalysisStep& s) {
     const auto t0 = opt_number(n, "t0"), t_end = opt_number(n, "t_end"), output_step = opt_number(n, "output_step");
-    const auto rtol = opt_number(n, "rtol"), atol = opt_number(n, "atol");
-    const auto max_step = opt_number(n, "max_step"), scale = opt_number(n, "constraint_scale");
-    const auto quiet_until = opt_number(n, "quiet_until");
+    const auto rtol = opt_number(n, "rtol"), atol = opt_number(n, "atol"), max_step = opt_number(n, "max_step");
     s.t0 = t0.value_or(s.t0);
     s.t_end = t_end.value_or(s.t_end);
     s.output_step = output_step.value_or(s.output_step);
     s.rtol = rtol.value_or(s.rtol);
     s.atol = atol.value_or(s.atol);
     s.max_step = max_step.value_or(s.max_step);
-    if (has(n, "output_projection")) {
-      const std::string v = text(n, "output_projection", "false");
-      if (v == "true") s.output_projection = true;
-      else if (v != "false") error(at(n, "output_projection"), "output_projection", "expected true or false, got " + quote(v));
-    }
-    if (has(n, "error_estimate")) {
-      const std::string v = text(n, "error_estimate", "false");
-      if (v == "true") s.error_estimate = true;
-      else if (v != "false") error(at(n, "error_estimate"), "error_estimate", "expected true or false, got " + quote(v));
-    }
-    const auto epcon = opt_number(n, "newton_convergence");
-    s.newton_convergence = epcon.value_or(s.newton_convergence);
-    if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))
-      error(at(n, "newton_convergence"), "newton_convergence",
-            "out of range (0, 1], got " + format_number(s.newton_convergence));
-    s.constraint_scale = scale.value_or(s.constraint_scale);
-    s.formulation = text(n, "formulation", "index3");
-    s.baumgarte_alpha = opt_number(n, "baumgarte_alpha").value_or(s.baumgarte_alpha);
-    s.baumgarte_beta = opt_number(n, "baumgarte_beta").value_or(s.baumgarte_beta);
     // Tolerances in model units (formulation/tolerance_scales.h): absent means derived.
     for (auto [key, field] : {std::pair<const char*, double*>{"length_scale", &s.length_scale}, {"time_scale", &s.time_scale},
                               {"atol_rotation", &s.atol_rotation}, {"atol_velocity", &s.atol_velocity}}) {
@@ -844,20 +838,6 @@ struct Loader {
       if (x && !(*x > 0)) error(n[key], key, "must be positive, got " + format_number(*x));
       else if (x) *field = *x;
     }
-    if (has(n, "baumgarte_alpha") && !(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
-    if (has(n, "baumgarte_beta") && !(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
-    s.penalty = opt_number(n, "penalty").value_or(s.penalty);
-    if (!(s.penalty > 0)) error(at(n, "penalty"), "penalty", "must be positive, got " + format_number(s.penalty));
-    s.quiet_until = quiet_until.value_or(s.quiet_until);
-    s.mode_check = text(n, "mode_check", s.mode_check);
-    if (has(n, "mode_check") && n["mode_check"].IsScalar() && s.mode_check != "warn" && s.mode_check != "fail" &&
-        s.mode_check != "off")
-      error(n["mode_check"], "mode_check", "expected warn, fail or off, got " + quote(s.mode_check));
-    const auto mode_deg = opt_number(n, "mode_check_deg");
-    s.mode_check_deg = mode_deg.value_or(s.mode_check_deg);
-    if (mode_deg && !(s.mode_check_deg > 0 && s.mode_check_deg <= 180))
-      error(n["mode_check_deg"], "mode_check_deg", "out of range (0, 180], got " + format_number(s.mode_check_deg));
-    s.quiet_sensors = names(n, "quiet_sensors");
     const bool times_ok = (t0 || !has(n, "t0")) && (t_end || !has(n, "t_end"));
     if (integrates && times_ok && !(s.t_end > s.t0))
       error(at(n, "t_end"), "t_end", "the time span is empty (t_end " + format_number(s.t_end) +
@@ -869,12 +849,65 @@ struct Loader {
     if (rtol && !rtol_range_error(s.rtol).empty()) error(n["rtol"], "rtol", rtol_range_error(s.rtol));
     if (atol && !atol_range_error(s.atol).empty()) error(n["atol"], "atol", atol_range_error(s.atol));
     if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
-    if (scale && s.constraint_scale < 0)
-      error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
+  }
+
+  // The formulation and its parameters (constraint scale, Baumgarte rates, penalty, Newton).
+  void step_formulation(const YAML::Node& n, AnalysisStep& s) {
+    s.formulation = text(n, "formulation", "index3");
     if (has(n, "formulation") && n["formulation"].IsScalar() && !find_formulation(s.formulation))
       error(n["formulation"], "formulation", "unknown formulation " + quote(s.formulation) + " (" + formulation_names() + ")");
+    const auto scale = opt_number(n, "constraint_scale");
+    s.constraint_scale = scale.value_or(s.constraint_scale);
+    if (scale && s.constraint_scale < 0)
+      error(n["constraint_scale"], "constraint_scale", "must not be negative (0: automatic), got " + format_number(s.constraint_scale));
+    s.newton_convergence = opt_number(n, "newton_convergence").value_or(s.newton_convergence);
+    if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))
+      error(at(n, "newton_convergence"), "newton_convergence", "out of range (0, 1], got " + format_number(s.newton_convergence));
+    s.baumgarte_alpha = opt_number(n, "baumgarte_alpha").value_or(s.baumgarte_alpha);
+    s.baumgarte_beta = opt_number(n, "baumgarte_beta").value_or(s.baumgarte_beta);
+    if (has(n, "baumgarte_alpha") && !(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));
+    if (has(n, "baumgarte_beta") && !(s.baumgarte_beta >= 0)) error(at(n, "baumgarte_beta"), "baumgarte_beta", "must not be negative, got " + format_number(s.baumgarte_beta));
+    s.penalty = opt_number(n, "penalty").value_or(s.penalty);
+    if (!(s.penalty > 0)) error(at(n, "penalty"), "penalty", "must be positive, got " + format_number(s.penalty));
+  }
+
+  // The checks a step reports on: the assembly mode check and the quiet sensors.
+  void step_checks(const YAML::Node& n, bool integrates, AnalysisStep& s) {
+    s.mode_check = text(n, "mode_check", s.mode_check);
+    if (has(n, "mode_check") && n["mode_check"].IsScalar() && s.mode_check != "warn" && s.mode_check != "fail" &&
+        s.mode_check != "off")
+      error(n["mode_check"], "mode_check", "expected warn, fail or off, got " + quote(s.mode_check));
+    const auto mode_deg = opt_number(n, "mode_check_deg");
+    s.mode_check_deg = mode_deg.value_or(s.mode_check_deg);
+    if (mode_deg && !(s.mode_check_deg > 0 && s.mode_check_deg <= 180))
+      error(n["mode_check_deg"], "mode_check_deg", "out of range (0, 180], got " + format_number(s.mode_check_deg));
+    s.quiet_until = opt_number(n, "quiet_until").value_or(s.quiet_until);
+    s.quiet_sensors = names(n, "quiet_sensors");
     if (integrates && !s.quiet_sensors.empty() && !has(n, "quiet_until"))
       error(n["quiet_sensors"], "quiet_until", "missing (quiet_sensors are watched until quiet_until)");
+  }
+
+  AnalysisStep step(const YAML::Node& n) {
+    AnalysisStep s;
+    s.where = where(n);
+    const Fields& general = analysis_fields();
+    if (!check_keys(n, "analysis step", general)) return s;
+    const std::string type = text(n, "type", "", true);
+    const AnalysisType* kind = find_analysis_type(type);
+    if (kind) s.type = kind->type;
+    else if (!type.empty()) error(n["type"], "type", "unknown analysis " + quote(type) + " (" + analysis_type_names() + ")");
+    const bool integrates = kind && kind->integrates;
+    if (kind) applies(n, (std::string("aeiou").find(type[0]) == std::string::npos ? "a " : "an ") + type + " step", general,
+                      kind->fields);
+    initial_velocities(n, type, s);
+    s.hold = names(n, "hold");
+    s.release = names(n, "release");
+    s.unknowns = names(n, "unknowns");
+    step_span_and_tolerances(n, integrates, s);
+    flag(n, "output_projection", s.output_projection);
+    flag(n, "error_estimate", s.error_estimate);
+    step_formulation(n, s);
+    step_checks(n, integrates, s);
     return s;
   }
 
@@ -1074,62 +1107,37 @@ std::optional<YAML::Node> parse(const std::string& text, const std::string& path
   }
 }
 
-// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
-// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
-// the scene could not be read far enough to be validated.
-bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
-          std::vector<OverrideTarget>& targets) {
-  const std::string& path = src.path;
-  const auto parsed = parse(src.text, path, issues);
-  if (!parsed) return false;
-  const YAML::Node root = *parsed;
-  Loader scene_loader{path, &issues, &lines};
-  if (!root.IsMap()) {
-    issues.push_back({path, Loader::line_of(root), "",
-                      root.IsNull() ? "the scene is empty" : "the scene must be a YAML mapping (field: value lines)"});
+// The model file the scene's `model` field names, parsed into `mroot` (read once: kept in
+// src.models). False when the field is empty or the file cannot be read or parsed.
+bool read_model_tree(SceneSource& src, Loader& l, const YAML::Node& root, std::vector<SceneIssue>& issues,
+                     std::optional<YAML::Node>& mroot, std::string& model_path) {
+  const std::string model = l.name(root, "model");
+  if (model.empty()) return false;
+  model_path = (std::filesystem::path(src.path).parent_path() / model).string();
+  std::string why;
+  auto known = src.models.find(model_path);
+  const auto model_text =
+      known != src.models.end() ? std::optional<std::string>(known->second) : read_text_file(model_path, why);
+  if (!model_text) l.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
+  else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
+  return mroot.has_value();
+}
+
+// The model file's sections (the scene's own are read after them and add to or patch them).
+bool load_model_sections(const YAML::Node& mroot, const std::string& model_path, Scene& scene,
+                         std::vector<SceneIssue>& issues, FieldLines& lines) {
+  Loader l{model_path, &issues, &lines};
+  if (!l.check_keys(mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts", "forces",
+                                     "sensors", "animation"}))
     return false;
-  }
-  lines.scene_root = scene_loader.where(root);
-  bool complete = true;
-  std::optional<YAML::Node> mroot;
-  std::string model_path;
-  if (scene_loader.has(root, "model")) {
-    const std::string model = scene_loader.name(root, "model");
-    if (model.empty()) {
-      complete = false;
-    } else {
-      model_path = (std::filesystem::path(path).parent_path() / model).string();
-      std::string why;
-      auto known = src.models.find(model_path);
-      const auto model_text = known != src.models.end() ? std::optional<std::string>(known->second)
-                                                        : read_text_file(model_path, why);
-      if (!model_text) scene_loader.error(root["model"], "model", "cannot read model file '" + model_path + "' (" + why + ")");
-      else mroot = parse(src.models[model_path] = *model_text, model_path, issues);
-      if (!mroot) complete = false;
-    }
-  }
-  if (!complete && !src.overrides.empty()) return false;
-  for (const auto& [p, v] : src.overrides)
-    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
-  scene_loader.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
-                                          "forces", "sensors", "remove", "analysis", "output",
-                                          "redundant_constraints", "animation"});
-  if (mroot) {
-    Loader model_loader{model_path, &issues, &lines};
-    if (model_loader.check_keys(*mroot, "model", {"name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts",
-                                                  "forces", "sensors", "animation"})) {
-      model_loader.sections(*mroot, scene.model, false);
-      if (model_loader.has(*mroot, "animation")) model_loader.animation((*mroot)["animation"], scene.animation);
-    } else {
-      complete = false;
-    }
-  }
-  scene_loader.sections(root, scene.model, true);
-  if (scene_loader.has(root, "animation")) scene_loader.animation(root["animation"], scene.animation);
-  for (const auto& shape : scene.animation.shapes)
-    if (std::none_of(scene.model.bodies.begin(), scene.model.bodies.end(), [&](const BodySpec& b) { return b.name == shape.body; }))
-      issues.push_back({shape.where.file, shape.where.line, "body", "animation shape on " + quote(shape.body) + ", which is not a body"});
-  for (const std::string& name : scene_loader.names(root, "remove")) {
+  l.sections(mroot, scene.model, false);
+  if (l.has(mroot, "animation")) l.animation(mroot["animation"], scene.animation);
+  return true;
+}
+
+// `remove`: forces, sensors and cuts of the model dropped by name.
+void remove_items(Loader& l, const YAML::Node& root, Model& m) {
+  for (const std::string& name : l.names(root, "remove")) {
     bool found = false;
     auto drop = [&](auto& vec) {
       for (auto it = vec.begin(); it != vec.end(); ++it)
@@ -1139,33 +1147,78 @@ bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, Field
           return;
         }
     };
-    drop(scene.model.forces);
-    drop(scene.model.sensors);
-    drop(scene.model.cuts);
-    if (!found) scene_loader.error(root["remove"], "remove", "nothing named " + quote(name) + " to remove (forces, sensors, cuts)");
+    drop(m.forces);
+    drop(m.sensors);
+    drop(m.cuts);
+    if (!found) l.error(root["remove"], "remove", "nothing named " + quote(name) + " to remove (forces, sensors, cuts)");
   }
-  if (scene_loader.has(root, "analysis")) {
+}
+
+// `analysis`: one step or a list of them, at most one of which integrates in time.
+void analysis_steps(Loader& l, const YAML::Node& root, Scene& scene) {
+  if (l.has(root, "analysis")) {
     const YAML::Node a = root["analysis"];
     if (a.IsSequence()) {
-      if (a.size() == 0) scene_loader.error(a, "analysis", "no analysis steps (assembly, equilibrium, kinematics or dynamics)");
-      for (const auto& s : a) scene.steps.push_back(scene_loader.step(s));
+      if (a.size() == 0) l.error(a, "analysis", "no analysis steps (assembly, equilibrium, kinematics or dynamics)");
+      for (const auto& s : a) scene.steps.push_back(l.step(s));
     } else {
-      scene.steps.push_back(scene_loader.step(a));
+      scene.steps.push_back(l.step(a));
     }
   } else {
-    scene_loader.error(root, "analysis", "missing (assembly, equilibrium, kinematics or dynamics steps)");
+    l.error(root, "analysis", "missing (assembly, equilibrium, kinematics or dynamics steps)");
   }
   int integrations = 0;
   for (const auto& s : scene.steps)
-    if (s.type == AnalysisStep::Type::kKinematics || s.type == AnalysisStep::Type::kDynamics) ++integrations;
-  if (integrations > 1) scene_loader.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
-  scene.columns = scene_loader.names(root, "output");
+    if (integrates(s)) ++integrations;
+  if (integrations > 1) l.error(root["analysis"], "analysis", "at most one kinematics or dynamics step per scene");
+}
+
+// Animation shapes, output columns, the redundancy policy.
+void scene_options(Loader& l, const YAML::Node& root, Scene& scene, std::vector<SceneIssue>& issues) {
+  if (l.has(root, "animation")) l.animation(root["animation"], scene.animation);
+  for (const auto& shape : scene.animation.shapes)
+    if (std::none_of(scene.model.bodies.begin(), scene.model.bodies.end(),
+                     [&](const BodySpec& b) { return b.name == shape.body; }))
+      issues.push_back({shape.where.file, shape.where.line, "body",
+                        "animation shape on " + quote(shape.body) + ", which is not a body"});
+  scene.columns = l.names(root, "output");
   if (root["redundant_constraints"]) {
-    scene.redundant_constraints = scene_loader.text(root, "redundant_constraints", "remove");
+    scene.redundant_constraints = l.text(root, "redundant_constraints", "remove");
     if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail")
-      scene_loader.error(root["redundant_constraints"], "redundant_constraints",
-                         "expected remove or fail, got '" + scene.redundant_constraints + "'");
+      l.error(root["redundant_constraints"], "redundant_constraints",
+              "expected remove or fail, got '" + scene.redundant_constraints + "'");
   }
+}
+
+// Loads into `scene` from `src` (the model file is read once and kept in src.models), with
+// src.overrides applied to the parsed trees first (their places in `targets`); returns false if
+// the scene could not be read far enough to be validated.
+bool load(SceneSource& src, Scene& scene, std::vector<SceneIssue>& issues, FieldLines& lines,
+          std::vector<OverrideTarget>& targets) {
+  const std::string& path = src.path;
+  const auto parsed = parse(src.text, path, issues);
+  if (!parsed) return false;
+  const YAML::Node root = *parsed;
+  Loader l{path, &issues, &lines};
+  if (!root.IsMap()) {
+    issues.push_back({path, Loader::line_of(root), "",
+                      root.IsNull() ? "the scene is empty" : "the scene must be a YAML mapping (field: value lines)"});
+    return false;
+  }
+  lines.scene_root = l.where(root);
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
+  bool complete = !l.has(root, "model") || read_model_tree(src, l, root, issues, mroot, model_path);
+  if (!complete && !src.overrides.empty()) return false;
+  for (const auto& [p, v] : src.overrides)
+    targets.push_back(apply_override(root, path, mroot ? &*mroot : nullptr, model_path, p, v));
+  l.check_keys(root, "scene", {"model", "name", "gravity", "ground", "bodies", "joints", "coordinates", "cuts", "forces",
+                               "sensors", "remove", "analysis", "output", "redundant_constraints", "animation"});
+  if (mroot && !load_model_sections(*mroot, model_path, scene, issues, lines)) complete = false;
+  l.sections(root, scene.model, true);
+  scene_options(l, root, scene, issues);
+  remove_items(l, root, scene.model);
+  analysis_steps(l, root, scene);
   return complete;
 }
 

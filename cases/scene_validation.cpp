@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 
+#include "cases/analysis_types.h"
 #include "core/errors.h"
 #include "core/expression.h"
 #include "formulation/forces.h"
@@ -563,7 +564,7 @@ struct Validator {
           if (!seen.insert(n).second) report(s.where, f, "coordinate '" + n + "' is listed twice");
         }
       }
-      if (s.type == A::kKinematics || s.type == A::kDynamics)
+      if (integrates(s))
         for (size_t k = 0; k < s.quiet_sensors.size(); ++k)
           if (!sensor_index.count(s.quiet_sensors[k]))
             report(s.where, indexed("quiet_sensors", k), "no sensor named '" + s.quiet_sensors[k] + "'" +

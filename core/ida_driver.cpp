@@ -136,276 +136,359 @@ std::string worst_components(void* mem, DaeProblem& p, N_Vector tmp1, N_Vector t
   return os.str();
 }
 
-}  // namespace
-
-IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>& y0,
-                   std::vector<double>& yp0,
-                   const std::function<bool(double, const double*, const double*)>& output) {
+// One integration: the SUNDIALS objects, the segment and sample bookkeeping, the statistics.
+// Built by open_run, advanced by the stages below; the destructor frees the SUNDIALS objects.
+struct IdaRun {
+  DaeProblem* problem = nullptr;
+  const IdaOptions* o = nullptr;
+  const std::function<bool(double, const double*, const double*)>* output = nullptr;
+  int n = 0;
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr, yp = nullptr, id = nullptr, ys = nullptr, yps = nullptr;
+  SUNMatrix jac = nullptr;
+  SUNLinearSolver ls = nullptr;
+  void* mem = nullptr;
+  UserData ud{};
+  double h_cap = 0;  // the first step never exceeds the default one
+  int nsw = 0;       // switching functions
+  std::vector<int> roots;
+  std::vector<double> bps;  // breakpoints inside the span, sorted
+  bool end_is_breakpoint = false;
+  size_t next_bp = 0;
+  long sample_index = 0;  // the next output sample; -1 once the last is emitted
+  bool stop_requested = false;
+  bool with_derivative = false;
+  double t = 0, t_prev = 0;  // the current time and that of the last accepted step
+  std::vector<double> y_prev, yp_prev;
   IdaStats stats;
-  const double cpu0 = cpu_now();
-  const int n = problem.size();
-  const CscPattern& pattern = problem.jacobian_pattern();
 
-  SUNContext ctx = make_sun_context();
-  if (!ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
-  N_Vector y = N_VNew_Serial(n, ctx), yp = N_VNew_Serial(n, ctx);
-  N_Vector id = N_VNew_Serial(n, ctx);
-  N_Vector ys = N_VNew_Serial(n, ctx), yps = N_VNew_Serial(n, ctx);
-  std::memcpy(N_VGetArrayPointer(y), y0.data(), n * sizeof(double));
-  std::memcpy(N_VGetArrayPointer(yp), yp0.data(), n * sizeof(double));
-  problem.error_test_mask(N_VGetArrayPointer(id));
+  IdaRun() = default;
+  IdaRun(const IdaRun&) = delete;
+  IdaRun& operator=(const IdaRun&) = delete;
+  ~IdaRun() {
+    if (mem) IDAFree(&mem);
+    if (ls) SUNLinSolFree(ls);
+    if (jac) SUNMatDestroy(jac);
+    for (N_Vector v : {y, yp, id, ys, yps})
+      if (v) N_VDestroy(v);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+};
 
-  SUNMatrix jac = SUNSparseMatrix(n, n, std::max(1, pattern.nnz()), CSC_MAT, ctx);
-  SUNLinearSolver ls = make_klu_linear_solver(pattern, ctx);
-  void* mem = IDACreate(ctx);
-  UserData ud{&problem, &pattern, mem, o.rtol, o.atol,
-              o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0), "", "", -1, 0.0};
-  const double h_cap = ud.h_initial;
-  auto choose_initial_step = [&](double tt) {
-    if (o.initial_step > 0) return;
-    const double h = problem.initial_step(tt, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), o.rtol, o.atol);
-    ud.h_initial = h > 0 ? std::min(h_cap, h) : h_cap;
-  };
-  choose_initial_step(o.t0);
-  IDAInit(mem, residual_fn, o.t0, y, yp);
-  IDAWFtolerances(mem, weights_fn);
-  IDASetUserData(mem, &ud);
-  keep_ida_errors(mem, ctx, &ud.last_ida_error);
-  IDASetId(mem, id);
-  IDASetSuppressAlg(mem, SUNTRUE);
-  IDASetLinearSolver(mem, ls, jac);
-  IDASetJacFn(mem, jacobian_fn);
-  IDASetMaxNumSteps(mem, o.max_steps);
-  IDASetMaxOrd(mem, o.max_order);
-  IDASetNonlinConvCoef(mem, o.nonlinear_convergence);
+double* data(N_Vector v) { return N_VGetArrayPointer(v); }
+
+void choose_initial_step(IdaRun& r, double tt) {
+  if (r.o->initial_step > 0) return;
+  const double h = r.problem->initial_step(tt, data(r.y), data(r.yp), r.o->rtol, r.o->atol);
+  r.ud.h_initial = h > 0 ? std::min(r.h_cap, h) : r.h_cap;
+}
+
+void configure_ida(IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  IDAInit(r.mem, residual_fn, o.t0, r.y, r.yp);
+  IDAWFtolerances(r.mem, weights_fn);
+  IDASetUserData(r.mem, &r.ud);
+  keep_ida_errors(r.mem, r.ctx, &r.ud.last_ida_error);
+  IDASetId(r.mem, r.id);
+  IDASetSuppressAlg(r.mem, SUNTRUE);
+  IDASetLinearSolver(r.mem, r.ls, r.jac);
+  IDASetJacFn(r.mem, jacobian_fn);
+  IDASetMaxNumSteps(r.mem, o.max_steps);
+  IDASetMaxOrd(r.mem, o.max_order);
+  IDASetNonlinConvCoef(r.mem, o.nonlinear_convergence);
   // Refresh the Newton matrix whenever cj changes by more than delta_cj: with index-3 rows the
   // matrix does not scale with cj, and IDA's rescaled old-matrix corrections fail to converge.
-  IDASetDeltaCjLSetup(mem, o.delta_cj);
-  if (o.max_step > 0) IDASetMaxStep(mem, o.max_step);
+  IDASetDeltaCjLSetup(r.mem, o.delta_cj);
+  if (o.max_step > 0) IDASetMaxStep(r.mem, o.max_step);
   // IDA's own first step, 0.5/|y'|, uses accelerations and is far too small for a multibody
-  // system at index 3; start from a fixed fraction of the span instead (the error test adapts it).
-  IDASetInitStep(mem, ud.h_initial);
-  const int nsw = problem.num_switches();
-  if (nsw > 0) {
-    IDARootInit(mem, nsw, root_fn);
-    IDASetNoInactiveRootWarn(mem);
+  // system at index 3; start from the problem's estimate instead (the error test adapts it).
+  IDASetInitStep(r.mem, r.ud.h_initial);
+  r.nsw = r.problem->num_switches();
+  if (r.nsw > 0) {
+    IDARootInit(r.mem, r.nsw, root_fn);
+    IDASetNoInactiveRootWarn(r.mem);
   }
-  std::vector<int> roots(std::max(1, nsw));
+  r.roots.assign(std::max(1, r.nsw), 0);
+}
 
-  // Breakpoints inside the span end segments. One at t1 makes the end a stop time (see
-  // next_stop below).
-  std::vector<double> bps;
-  bool end_is_breakpoint = false;
-  for (double b : problem.breakpoints()) {
-    if (b > o.t0 && b < o.t1) bps.push_back(b);
-    if (std::fabs(b - o.t1) <= 1e-12 * std::max(1.0, std::fabs(o.t1))) end_is_breakpoint = true;
+// Breakpoints inside the span end segments. One at t1 makes the end a stop time (next_stop).
+void find_breakpoints(IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  for (double b : r.problem->breakpoints()) {
+    if (b > o.t0 && b < o.t1) r.bps.push_back(b);
+    if (std::fabs(b - o.t1) <= 1e-12 * std::max(1.0, std::fabs(o.t1))) r.end_is_breakpoint = true;
   }
-  std::sort(bps.begin(), bps.end());
+  std::sort(r.bps.begin(), r.bps.end());
+}
 
-  // A failure other than IDA's own (those: `failure` below) ends the run; the first one is kept.
-  auto fail = [&](const std::string& status, const std::string& message, double tt) {
-    if (!stats.ok) return;
-    stats.ok = false;
-    stats.status = status;
-    stats.message = message;
-    stats.t_reached = tt;
-  };
-  // False (and the run failed) if x, a state or its derivative at tt, has a NaN or an infinity.
-  auto finite = [&](const double* x, double tt, const char* what) {
-    const int i = first_non_finite(x, n);
-    if (i < 0) return true;
-    const SolveError e = non_finite_error(what + problem.component_name(i) + " (y[" + std::to_string(i) + "])", x[i], tt);
-    fail(e.status, e.what(), tt);
-    return false;
-  };
-  // IDA's interpolant of y (k = 0) or y' (k = 1) at tt into v.
-  auto interpolate = [&](double tt, int k, N_Vector v) {
-    const int flag = IDAGetDky(mem, tt, k, v);
-    if (flag == IDA_SUCCESS) return true;
-    fail("integration_failed", "interpolating the solution at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
-    return false;
-  };
+void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double>& yp0) {
+  const IdaOptions& o = *r.o;
+  r.n = r.problem->size();
+  r.ctx = make_sun_context();
+  if (!r.ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
+  for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) *v = N_VNew_Serial(r.n, r.ctx);
+  std::memcpy(data(r.y), y0.data(), r.n * sizeof(double));
+  std::memcpy(data(r.yp), yp0.data(), r.n * sizeof(double));
+  r.problem->error_test_mask(data(r.id));
+  const CscPattern& pattern = r.problem->jacobian_pattern();
+  r.jac = SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx);
+  r.ls = make_klu_linear_solver(pattern, r.ctx);
+  r.mem = IDACreate(r.ctx);
+  r.ud.problem = r.problem;
+  r.ud.pattern = &pattern;
+  r.ud.mem = r.mem;
+  r.ud.rtol = o.rtol;
+  r.ud.atol = o.atol;
+  r.ud.h_initial = o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0);
+  r.h_cap = r.ud.h_initial;
+  choose_initial_step(r, o.t0);
+  configure_ida(r);
+  find_breakpoints(r);
+  r.with_derivative = r.problem->output_needs_derivative();
+  r.t = r.t_prev = o.t0;
+  r.y_prev = y0;
+  r.yp_prev = yp0;
+}
 
-  // Output samples.
-  long sample_index = 0;
-  auto sample_time = [&](long k) {
-    return o.output_step > 0 ? std::min(o.t1, o.t0 + k * o.output_step) : (k == 0 ? o.t0 : o.t1);
-  };
-  bool stop_requested = false;
-  const bool with_derivative = problem.output_needs_derivative();
-  // One sample to the caller, after checking it: a SolveError thrown there (a sensor that is
-  // not finite) ends the run like a failure of the solver.
-  auto emit = [&](double ts, const double* yy, const double* yyp) {
-    if (!finite(yy, ts, "") || (yyp && !finite(yyp, ts, "derivative of "))) return;
-    try {
-      if (!output(ts, yy, yyp)) stop_requested = true;
-    } catch (const SolveError& e) {
-      fail(e.status, e.what(), ts);
+// A failure other than IDA's own (those: ida_failure) ends the run; the first one is kept.
+void fail(IdaRun& r, const std::string& status, const std::string& message, double tt) {
+  if (!r.stats.ok) return;
+  r.stats.ok = false;
+  r.stats.status = status;
+  r.stats.message = message;
+  r.stats.t_reached = tt;
+}
+
+// False (and the run failed) if x, a state or its derivative at tt, has a NaN or an infinity.
+bool finite(IdaRun& r, const double* x, double tt, const char* what) {
+  const int i = first_non_finite(x, r.n);
+  if (i < 0) return true;
+  const SolveError e =
+      non_finite_error(what + r.problem->component_name(i) + " (y[" + std::to_string(i) + "])", x[i], tt);
+  fail(r, e.status, e.what(), tt);
+  return false;
+}
+
+// IDA's interpolant of y (k = 0) or y' (k = 1) at tt into v.
+bool interpolate(IdaRun& r, double tt, int k, N_Vector v) {
+  const int flag = IDAGetDky(r.mem, tt, k, v);
+  if (flag == IDA_SUCCESS) return true;
+  fail(r, "integration_failed",
+       "interpolating the solution at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
+  return false;
+}
+
+// IDA stopped with an error: the message names the worst error estimates and IDA's own words.
+void ida_failure(IdaRun& r, int flag) {
+  double tt = r.t;
+  IDAGetCurrentTime(r.mem, &tt);
+  if (r.ud.non_finite >= 0) {
+    const int i = r.ud.non_finite;
+    const SolveError e =
+        non_finite_error(r.problem->component_name(i) + " (y[" + std::to_string(i) + "])", r.ud.non_finite_value, tt);
+    return fail(r, e.status, e.what(), tt);
+  }
+  if (!r.ud.callback_error.empty())
+    return fail(r, "internal_error", "the DAE's " + r.ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
+  std::ostringstream os;
+  double h = 0;
+  IDAGetCurrentStep(r.mem, &h);
+  os << "IDA failed at t = " << tt << " with step size " << h << " (" << ida_flag_name(flag) << ")";
+  const std::string worst = worst_components(r.mem, *r.problem, r.ys, r.yps, r.id);
+  if (!worst.empty()) os << "; largest error estimates: " << worst;
+  if (!r.ud.last_ida_error.empty()) os << "; IDA: " << r.ud.last_ida_error;
+  r.stats.ok = false;
+  r.stats.status = "integration_failed";
+  r.stats.message = os.str();
+  r.stats.t_reached = r.t;
+}
+
+double sample_time(const IdaRun& r, long k) {
+  const IdaOptions& o = *r.o;
+  return o.output_step > 0 ? std::min(o.t1, o.t0 + k * o.output_step) : (k == 0 ? o.t0 : o.t1);
+}
+
+// One sample to the caller, after checking it: a SolveError thrown there (a sensor that is not
+// finite) ends the run like a failure of the solver.
+void emit(IdaRun& r, double ts, const double* yy, const double* yyp) {
+  if (!finite(r, yy, ts, "") || (yyp && !finite(r, yyp, ts, "derivative of "))) return;
+  try {
+    if (!(*r.output)(ts, yy, yyp)) r.stop_requested = true;
+  } catch (const SolveError& e) {
+    fail(r, e.status, e.what(), ts);
+  }
+}
+
+// Every sample up to t_reached, always from IDA's interpolant (also at a step's own time: the y'
+// IDA returns at a stop time is not the derivative of its position interpolant).
+void emit_until(IdaRun& r, double t_reached) {
+  while (!r.stop_requested && r.stats.ok && r.sample_index >= 0) {
+    const double ts = sample_time(r, r.sample_index);
+    if (ts > t_reached) break;
+    if (!interpolate(r, ts, 0, r.ys) || (r.with_derivative && !interpolate(r, ts, 1, r.yps))) break;
+    emit(r, ts, data(r.ys), r.with_derivative ? data(r.yps) : nullptr);
+    if (ts >= r.o->t1) {
+      r.sample_index = -1;
+      break;
     }
-  };
-  auto emit_until = [&](double t_reached, bool inclusive) {
-    while (!stop_requested && stats.ok && sample_index >= 0) {
-      const double ts = sample_time(sample_index);
-      if (ts > t_reached || (!inclusive && ts == t_reached)) break;
-      // Always from IDA's interpolant (also at a step's own time: the y' IDA returns at a stop
-      // time is not the derivative of its position interpolant).
-      if (!interpolate(ts, 0, ys) || (with_derivative && !interpolate(ts, 1, yps))) break;
-      emit(ts, N_VGetArrayPointer(ys), with_derivative ? N_VGetArrayPointer(yps) : nullptr);
-      if (ts >= o.t1) { sample_index = -1; break; }
-      ++sample_index;
-    }
-  };
+    ++r.sample_index;
+  }
+}
+
+// The end of the run is a stop time only where the inputs are not smooth there (a drive's last
+// knot): elsewhere the last step may go past t1 and the end is interpolated like every sample.
+// A last step shortened to land on t1 can fail at index 3, where the Newton matrix's condition
+// grows as 1/h^2 (verification/iftomm: EngineFindings.LastStepToTheEndTime).
+double next_stop(const IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  if (r.next_bp < r.bps.size()) return r.bps[r.next_bp];
+  return r.end_is_breakpoint ? o.t1 : o.t1 + (o.t1 - o.t0);
+}
+
+// Only a real breakpoint ends a segment: the end of the run is no jump of the inputs.
+double segment_end(const IdaRun& r) { return r.next_bp < r.bps.size() ? r.bps[r.next_bp] : 1e300; }
+
+// The last accepted step (interpolated root states are never kept).
+void keep_step(IdaRun& r) {
+  r.t_prev = r.t;
+  std::memcpy(r.y_prev.data(), data(r.y), r.n * sizeof(double));
+  std::memcpy(r.yp_prev.data(), data(r.yp), r.n * sizeof(double));
+}
+
+// IDA's counters restart at every IDAReInit: add them up first (and once more at the end).
+void reinit(IdaRun& r, double tt) {
+  collect(r.mem, r.stats);
+  IDAReInit(r.mem, tt, r.y, r.yp);
+}
+
+// A step past t1: the end state and the last samples are interpolated; a root beyond t1 is no
+// event of this run.
+void finish_past_end(IdaRun& r, int flag, double tret) {
+  if (flag != IDA_ROOT_RETURN) r.problem->after_step(tret, data(r.y));
+  emit_until(r, r.o->t1);
+  if (r.stats.ok && interpolate(r, r.o->t1, 0, r.y) && interpolate(r, r.o->t1, 1, r.yp)) r.t = r.o->t1;
+}
+
+// The state IDA returns at a root is interpolated, and the interpolated velocities are not
+// error-controlled at index 3. Step back to the last accepted step and integrate again with the
+// root time as stop time, so that the state at the root is a converged step. False: the run ends.
+bool step_onto_root(IdaRun& r, double t_root) {
+  const double h_default = r.ud.h_initial;
+  choose_initial_step(r, r.t_prev);
+  r.ud.h_initial = std::min(r.ud.h_initial, t_root - r.t_prev);
+  if (r.ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
+    std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
+    std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
+    IDASetInitStep(r.mem, r.ud.h_initial);
+    reinit(r, r.t_prev);
+    IDARootInit(r.mem, 0, nullptr);
+    IDASetStopTime(r.mem, t_root);
+    r.t = r.t_prev;
+  } else {
+    r.t = t_root;  // the root is at the last step: its state is that step's
+  }
+  int flag = IDA_SUCCESS;
+  double tret = r.t;
+  while (r.t < t_root && !r.stop_requested && r.stats.ok) {
+    flag = IDASolve(r.mem, t_root, &tret, r.y, r.yp, IDA_ONE_STEP);
+    if (flag < 0 || !finite(r, data(r.y), tret, "")) break;
+    r.t = tret;
+    r.problem->after_step(r.t, data(r.y));
+    emit_until(r, r.t);
+  }
+  IDARootInit(r.mem, r.nsw, root_fn);
+  r.ud.h_initial = h_default;
+  IDASetInitStep(r.mem, r.ud.h_initial);
+  if (flag < 0) ida_failure(r, flag);
+  if (!r.stats.ok) return false;
+  r.stats.event_times.push_back(r.t);
+  return true;
+}
+
+// After an event (roots: which functions crossed) or a breakpoint (roots null): the problem's
+// restart (new modes, a consistent state), then IDA anew from there. False: the run ends.
+bool restart(IdaRun& r, const int* roots) {
+  while (r.next_bp < r.bps.size() && r.bps[r.next_bp] <= r.t) ++r.next_bp;
+  r.problem->set_segment(r.t, segment_end(r));
+  try {
+    r.problem->restart(r.t, data(r.y), data(r.yp), roots);
+  } catch (const SolveError& e) {
+    fail(r, e.status, std::string("restart at t = ") + std::to_string(r.t) + " failed: " + e.what(), r.t);
+    return false;
+  }
+  if (!finite(r, data(r.y), r.t, "") || !finite(r, data(r.yp), r.t, "derivative of ")) return false;
+  ++r.stats.restarts;
+  choose_initial_step(r, r.t);
+  IDASetInitStep(r.mem, r.ud.h_initial);
+  reinit(r, r.t);
+  IDASetStopTime(r.mem, next_stop(r));
+  keep_step(r);
+  return true;
+}
+
+// One IDA step and what follows it (samples, an event, a breakpoint). False: the run ends.
+bool advance(IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  double tret = r.t;
+  const int flag = IDASolve(r.mem, o.t1, &tret, r.y, r.yp, IDA_ONE_STEP);
+  if (flag < 0) {
+    ida_failure(r, flag);
+    return false;
+  }
+  if (!finite(r, data(r.y), tret, "")) return false;
+  if (tret > o.t1) {
+    finish_past_end(r, flag, tret);
+    return false;
+  }
+  // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
+  const bool at_breakpoint = r.next_bp < r.bps.size() &&
+                             std::fabs(tret - r.bps[r.next_bp]) <= 1e-12 * std::max(1.0, std::fabs(tret));
+  const bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
+  if (is_root) {
+    IDAGetRootInfo(r.mem, r.roots.data());
+    // A root that changes no mode (a switching function grazing zero) needs no restart.
+    if (!r.problem->changes_mode(tret, data(r.y), r.roots.data())) return true;
+    if (!step_onto_root(r, tret)) return false;
+  } else {
+    r.t = tret;
+    r.problem->after_step(r.t, data(r.y));
+    emit_until(r, r.t);
+    if (!r.stats.ok) return false;
+    keep_step(r);
+    if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) return true;
+    if (r.t >= o.t1) return false;
+    r.stats.breakpoint_times.push_back(r.t);
+    ++r.next_bp;
+  }
+  return restart(r, is_root ? r.roots.data() : nullptr);
+}
+
+}  // namespace
+
+IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>& y0, std::vector<double>& yp0,
+                   const std::function<bool(double, const double*, const double*)>& output) {
+  const double cpu0 = cpu_now();
+  IdaRun r;
+  r.problem = &problem;
+  r.o = &o;
+  r.output = &output;
+  open_run(r, y0, yp0);
   // The first sample is the initial state.
-  emit(o.t0, y0.data(), yp0.data());
-  sample_index = 1;
-
-  double t = o.t0;
-  size_t next_bp = 0;
-  // The end of the run is a stop time only where the inputs are not smooth there (a drive's
-  // last knot): elsewhere the last step may go past t1 and the end is interpolated like every
-  // sample. A last step shortened to land on t1 can fail at index 3, where the Newton matrix's
-  // condition grows as 1/h^2 (verification/iftomm: EngineFindings.LastStepToTheEndTime).
-  const double t_beyond = o.t1 + (o.t1 - o.t0);
-  auto next_stop = [&] {
-    return next_bp < bps.size() ? bps[next_bp] : end_is_breakpoint ? o.t1 : t_beyond;
-  };
-  // Only a real breakpoint ends a segment: the end of the run is no jump of the inputs.
-  auto segment_end = [&] { return next_bp < bps.size() ? bps[next_bp] : 1e300; };
-  IDASetStopTime(mem, next_stop());
-  problem.set_segment(t, segment_end());
-  // The last accepted step (interpolated root states are never kept here).
-  double t_prev = t;
-  std::vector<double> y_prev(y0), yp_prev(yp0);
-  auto keep_step = [&](double tt) {
-    t_prev = tt;
-    std::memcpy(y_prev.data(), N_VGetArrayPointer(y), n * sizeof(double));
-    std::memcpy(yp_prev.data(), N_VGetArrayPointer(yp), n * sizeof(double));
-  };
-  // IDA's counters restart at every IDAReInit: add them up first (and once more at the end).
-  auto reinit = [&](double tt) {
-    collect(mem, stats);
-    IDAReInit(mem, tt, y, yp);
-  };
-  auto failure = [&](int flag, double tt) {
-    IDAGetCurrentTime(mem, &tt);
-    if (ud.non_finite >= 0) {
-      const int i = ud.non_finite;
-      const SolveError e = non_finite_error(problem.component_name(i) + " (y[" + std::to_string(i) + "])",
-                                            ud.non_finite_value, tt);
-      return fail(e.status, e.what(), tt);
-    }
-    if (!ud.callback_error.empty())
-      return fail("internal_error", "the DAE's " + ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
-    std::ostringstream os;
-    double h = 0;
-    IDAGetCurrentStep(mem, &h);
-    os << "IDA failed at t = " << tt << " with step size " << h << " (" << ida_flag_name(flag) << ")";
-    const std::string worst = worst_components(mem, problem, ys, yps, id);
-    if (!worst.empty()) os << "; largest error estimates: " << worst;
-    if (!ud.last_ida_error.empty()) os << "; IDA: " << ud.last_ida_error;
-    stats.ok = false;
-    stats.status = "integration_failed";
-    stats.message = os.str();
-    stats.t_reached = t;
-  };
-  while (!stop_requested && stats.ok && t < o.t1) {
+  emit(r, o.t0, y0.data(), yp0.data());
+  r.sample_index = 1;
+  IDASetStopTime(r.mem, next_stop(r));
+  problem.set_segment(r.t, segment_end(r));
+  while (!r.stop_requested && r.stats.ok && r.t < o.t1) {
     if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
-    double tret = t;
-    int flag = IDASolve(mem, o.t1, &tret, y, yp, IDA_ONE_STEP);
-    if (flag < 0) {
-      failure(flag, tret);
-      break;
-    }
-    if (!finite(N_VGetArrayPointer(y), tret, "")) break;
-    if (tret > o.t1) {
-      // Past the end: the end state and the last samples are interpolated; a root beyond t1 is
-      // no event of this run.
-      if (flag != IDA_ROOT_RETURN) problem.after_step(tret, N_VGetArrayPointer(y));
-      emit_until(o.t1, true);
-      if (stats.ok && interpolate(o.t1, 0, y) && interpolate(o.t1, 1, yp)) t = o.t1;
-      break;
-    }
-    // A root found exactly at a breakpoint is the breakpoint's own jump: restart from signs.
-    const bool at_breakpoint = next_bp < bps.size() &&
-                               std::fabs(tret - bps[next_bp]) <= 1e-12 * std::max(1.0, std::fabs(tret));
-    bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
-    if (is_root) {
-      IDAGetRootInfo(mem, roots.data());
-      // A root that changes no mode (a switching function grazing zero) needs no restart.
-      if (!problem.changes_mode(tret, N_VGetArrayPointer(y), roots.data())) continue;
-      // The state IDA returns at a root is interpolated, and the interpolated velocities are
-      // not error-controlled at index 3. Step back to the last accepted step and integrate again
-      // with the root time as stop time, so that the state at the root is a converged step.
-      const double t_root = tret;
-      const double h_default = ud.h_initial;
-      choose_initial_step(t_prev);
-      ud.h_initial = std::min(ud.h_initial, t_root - t_prev);
-      if (ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
-        std::memcpy(N_VGetArrayPointer(y), y_prev.data(), n * sizeof(double));
-        std::memcpy(N_VGetArrayPointer(yp), yp_prev.data(), n * sizeof(double));
-        IDASetInitStep(mem, ud.h_initial);
-        reinit(t_prev);
-        IDARootInit(mem, 0, nullptr);
-        IDASetStopTime(mem, t_root);
-        t = t_prev;
-      } else {
-        t = t_root;  // the root is at the last step: its state is that step's
-      }
-      while (t < t_root && !stop_requested && stats.ok) {
-        flag = IDASolve(mem, t_root, &tret, y, yp, IDA_ONE_STEP);
-        if (flag < 0 || !finite(N_VGetArrayPointer(y), tret, "")) break;
-        t = tret;
-        problem.after_step(t, N_VGetArrayPointer(y));
-        emit_until(t, true);
-      }
-      IDARootInit(mem, nsw, root_fn);
-      ud.h_initial = h_default;
-      IDASetInitStep(mem, ud.h_initial);
-      if (flag < 0) {
-        failure(flag, tret);
-        break;
-      }
-      if (!stats.ok) break;
-      stats.event_times.push_back(t);
-    } else {
-      t = tret;
-      problem.after_step(t, N_VGetArrayPointer(y));
-      emit_until(t, true);
-      if (!stats.ok) break;
-      keep_step(t);
-      if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) continue;
-      if (t >= o.t1) break;
-      stats.breakpoint_times.push_back(t);
-      ++next_bp;
-    }
-    while (next_bp < bps.size() && bps[next_bp] <= t) ++next_bp;
-    problem.set_segment(t, segment_end());
-    try {
-      problem.restart(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), is_root ? roots.data() : nullptr);
-    } catch (const SolveError& e) {
-      fail(e.status, std::string("restart at t = ") + std::to_string(t) + " failed: " + e.what(), t);
-      break;
-    }
-    if (!finite(N_VGetArrayPointer(y), t, "") || !finite(N_VGetArrayPointer(yp), t, "derivative of ")) break;
-    ++stats.restarts;
-    choose_initial_step(t);
-    IDASetInitStep(mem, ud.h_initial);
-    reinit(t);
-    IDASetStopTime(mem, next_stop());
-    keep_step(t);
+    if (!advance(r)) break;
   }
-  collect(mem, stats);
-  if (stats.ok) stats.t_reached = t;
-  stats.fresh_factorizations = klu_linear_solver_fresh_factorizations(ls);
-  std::memcpy(y0.data(), N_VGetArrayPointer(y), n * sizeof(double));
-  std::memcpy(yp0.data(), N_VGetArrayPointer(yp), n * sizeof(double));
-  IDAFree(&mem);
-  SUNLinSolFree(ls);
-  SUNMatDestroy(jac);
-  for (N_Vector v : {y, yp, id, ys, yps}) N_VDestroy(v);
-  SUNContext_Free(&ctx);
-  stats.cpu_seconds = cpu_now() - cpu0;
-  return stats;
+  collect(r.mem, r.stats);
+  if (r.stats.ok) r.stats.t_reached = r.t;
+  r.stats.fresh_factorizations = klu_linear_solver_fresh_factorizations(r.ls);
+  std::memcpy(y0.data(), data(r.y), r.n * sizeof(double));
+  std::memcpy(yp0.data(), data(r.yp), r.n * sizeof(double));
+  r.stats.cpu_seconds = cpu_now() - cpu0;
+  return r.stats;
 }
 
 }  // namespace mbdae

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "cases/analysis_types.h"
 #include "cases/cli_options.h"
 #include "cases/scene.h"
 #include "core/errors.h"
@@ -57,7 +58,7 @@ void check_command_line(const std::vector<std::string>& args, const mbdae::Scene
   if (o.out_dir.empty()) std::abort();
   if (!scene || !mbdae::check_overrides(*scene, o).empty() || !(o.output_step > 0)) return;
   for (const auto& s : scene->steps)
-    if ((s.type == mbdae::AnalysisStep::Type::kKinematics || s.type == mbdae::AnalysisStep::Type::kDynamics) &&
+    if (mbdae::integrates(s) &&
         s.t_end > s.t0 && (s.t_end - s.t0) / o.output_step > 1e8)
       std::abort();
 }

@@ -13,6 +13,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "cases/analysis_types.h"
 #include "cases/animation_sink.h"
 #include "cases/mbdae.h"
 #include "cases/sinks.h"
@@ -68,15 +69,7 @@ unsigned long main_thread_id() {
   return id;
 }
 
-const char* step_type_name(mbdae::AnalysisStep::Type t) {
-  switch (t) {
-    case mbdae::AnalysisStep::Type::kAssembly: return "assembly";
-    case mbdae::AnalysisStep::Type::kEquilibrium: return "equilibrium";
-    case mbdae::AnalysisStep::Type::kKinematics: return "kinematics";
-    case mbdae::AnalysisStep::Type::kDynamics: return "dynamics";
-  }
-  return "?";
-}
+const char* step_type_name(mbdae::AnalysisStep::Type t) { return mbdae::analysis_type(t).name.c_str(); }
 
 // Runs on a private copy of the scene (another Python thread may change the caller's Scene) with
 // the GIL released, so runs in Python threads proceed in parallel. In the main thread the run goes

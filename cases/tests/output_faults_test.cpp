@@ -125,13 +125,18 @@ class OutputFaults : public ::testing::Test {
     return pid;
   }
   // Waits until the run has written at least `bytes` of rows.
-  bool wait_for_rows(size_t bytes) {
+  // Waits (up to 120 s: the sanitizer build on a loaded machine is slow) until the run `pid` has
+  // written `bytes` of rows. On a timeout the run is killed and reaped, so that no run is left
+  // behind by a failed test.
+  bool wait_for_rows(pid_t pid, size_t bytes) {
     const fs::path partial = out / "results.csv.partial";
-    for (int k = 0; k < 3000; ++k) {
+    for (int k = 0; k < 12000; ++k) {
       std::error_code ec;
       if (fs::exists(partial, ec) && fs::file_size(partial, ec) >= bytes) return true;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
     return false;
   }
   static int wait_exit(pid_t pid, int* signal = nullptr) {
@@ -210,7 +215,7 @@ TEST_F(OutputFaults, OutputFolderProblemsBeforeSolving) {
 // not mixed with anything.
 TEST_F(OutputFaults, ConcurrentRunsIntoOneFolder) {
   const pid_t first = start(scene("10000"), "first.log");
-  ASSERT_TRUE(wait_for_rows(20000));
+  ASSERT_TRUE(wait_for_rows(first, 20000));
   const CliResult r = shell(exe() + " run " + sh_quote(scene("1", "other.yaml")) + " --out " + sh_quote(out) + " --quiet");
   EXPECT_EQ(r.code, 4) << r.output;
   EXPECT_NE(r.output.find("is in use by another run"), std::string::npos) << r.output;
@@ -228,7 +233,7 @@ TEST_F(OutputFaults, SigtermAndSigintDuringRun) {
     fs::create_directories(out);
     std::ofstream(out / "summary.json") << R"({"status": "ok"})";
     const pid_t pid = start(scene("10000"), "run.log");
-    ASSERT_TRUE(wait_for_rows(50000));
+    ASSERT_TRUE(wait_for_rows(pid, 50000));
     EXPECT_FALSE(fs::exists(out / "summary.json"));  // the old "ok" is not left behind
     kill(pid, sig);
     EXPECT_EQ(wait_exit(pid), 128 + sig) << read_file(dir / "run.log");
@@ -246,7 +251,7 @@ TEST_F(OutputFaults, SigkillLeavesWholeRows) {
   for (int k = 0; k < 5; ++k) {
     fs::remove_all(out);
     const pid_t pid = start(scene("10000"), "run.log");
-    ASSERT_TRUE(wait_for_rows(20000 + 37000 * k));
+    ASSERT_TRUE(wait_for_rows(pid, 20000 + 37000 * k));
     kill(pid, SIGKILL);
     int sig = 0;
     wait_exit(pid, &sig);

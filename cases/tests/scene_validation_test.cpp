@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cases/analysis_types.h"
 #include "cases/scene.h"
 #include "cases/tests/run_command.h"
 #include "core/errors.h"
@@ -170,6 +171,25 @@ TEST(SceneValidation, FieldGivenTwice) {
 TEST(SceneValidation, FieldDoesNotApplyToType) {
   const std::string t = with("stiffness: 10,", "stiffness: 10, radius: 0.3,");
   expect_one(t, line_of(t, "radius: 0.3"), "radius", "does not apply to a spring_damper force");
+}
+
+// The analysis types come from one table (cases/analysis_types.h): their names in the message for
+// an unknown one, their own fields in the message for a field of another type.
+TEST(SceneValidation, AnalysisTypesFromTheRegistry) {
+  std::string t = with("{type: assembly}", "{type: linearization}");
+  expect_one(t, line_of(t, "linearization"), "type",
+             "unknown analysis 'linearization' (" + analysis_type_names() + ")");
+  EXPECT_NE(analysis_type_names().find("equilibrium"), std::string::npos);
+  t = with("{type: assembly}", "{type: assembly, rtol: 1.0e-6}");
+  expect_one(t, line_of(t, "rtol: 1.0e-6}"), "rtol",
+             "does not apply to an assembly step (its fields: type, hold, t0, mode_check, mode_check_deg)");
+  for (AnalysisStep::Type type : {AnalysisStep::Type::kAssembly, AnalysisStep::Type::kEquilibrium,
+                                  AnalysisStep::Type::kKinematics, AnalysisStep::Type::kDynamics}) {
+    const AnalysisType& a = analysis_type(type);
+    EXPECT_EQ(find_analysis_type(a.name), &a);
+    EXPECT_TRUE(a.stage != nullptr) << a.name;
+    EXPECT_EQ(a.integrates, type == AnalysisStep::Type::kKinematics || type == AnalysisStep::Type::kDynamics);
+  }
 }
 
 TEST(SceneValidation, WrongTypeNumber) {

@@ -38,37 +38,8 @@ constexpr double kPi = 3.14159265358979323846;
 using testing::random_state;
 using State = testing::RandomState;
 
-Eigen::MatrixXd analytic_matrix(DaeProblem& dae, double t, double cj, const std::vector<double>& y,
-                                const std::vector<double>& yp) {
-  const int n = dae.size();
-  const CscPattern& p = dae.jacobian_pattern();
-  std::vector<double> values(p.nnz());
-  dae.jacobian(t, cj, y.data(), yp.data(), values.data());
-  Eigen::MatrixXd an = Eigen::MatrixXd::Zero(n, n);
-  for (int c = 0; c < n; ++c)
-    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) an(p.rowind[k], c) += values[k];
-  return an;
-}
-
-// Central differences of F(t, y + e, y' + cj e) column by column.
-Eigen::MatrixXd fd_matrix(DaeProblem& dae, double t, double cj, const std::vector<double>& y,
-                          const std::vector<double>& yp) {
-  const int n = dae.size();
-  Eigen::MatrixXd fd(n, n);
-  std::vector<double> rp(n), rm(n);
-  const double eps = 1e-6;
-  for (int c = 0; c < n; ++c) {
-    std::vector<double> yy = y, yyp = yp, ym = y, ymp = yp;
-    yy[c] += eps;
-    yyp[c] += cj * eps;
-    ym[c] -= eps;
-    ymp[c] -= cj * eps;
-    dae.residual(t, yy.data(), yyp.data(), rp.data());
-    dae.residual(t, ym.data(), ymp.data(), rm.data());
-    for (int r = 0; r < n; ++r) fd(r, c) = (rp[r] - rm[r]) / (2 * eps);
-  }
-  return fd;
-}
+using testing::analytic_matrix;
+using testing::fd_matrix;
 
 // max over entries of |an - fd| / (1 + |fd|), with a failure per bad entry.
 double compare(DaeProblem& dae, const Eigen::MatrixXd& an, const Eigen::MatrixXd& fd, double tol,

@@ -25,7 +25,9 @@ using testing::RandomState;
 TEST(JacobianFd, ConstraintGradientsAndHessians) {
   const System sys = build_system(all_types_model());
   const RandomState st = random_state(sys, 1);
-  int checked[6] = {0, 0, 0, 0, 0, 0};
+  // One count per Constraint::Type (kOrientation is the last).
+  constexpr int kTypes = static_cast<int>(Constraint::Type::kOrientation) + 1;
+  int checked[kTypes] = {};
   for (const Constraint& c : sys.constraints) {
     const LocalState s = gather(st.q.data(), c.bi, c.bj);
     Vec14 x = Vec14::Zero();
@@ -71,7 +73,7 @@ TEST(JacobianFd, ConstraintGradientsAndHessians) {
     }
     checked[static_cast<int>(c.type)]++;
   }
-  for (int t = 0; t < 6; ++t) EXPECT_GT(checked[t], 0) << "constraint type " << t << " not exercised";
+  for (int t = 0; t < kTypes; ++t) EXPECT_GT(checked[t], 0) << "constraint type " << t << " not exercised";
 }
 
 // gamma = -d2Phi/dt2 along q(t) = q + v t (q'' = 0), by a central second difference in time.
