@@ -30,12 +30,13 @@ class AugmentedSolver {
   bool accelerations(const std::vector<char>& modes, const double* q, const double* v, double t,
                      double* a, double* lambda);
   // The accelerations of an output sample, without a factorization where one of a nearby state
-  // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration matrix
-  // K0 (a KluSolver of its own, so that output samples do not change the factorizations the
-  // integration's own solves see), from x extrapolated through the last output samples (quadratic in t), accepted when the
-  // estimated error of a and of lambda is below `tolerance` times their max norms; else the direct
-  // solve of accelerations(). Samples come in increasing t; another call of accelerations() (a
-  // restart, possibly over a discontinuity) starts the extrapolation afresh.
+  // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration
+  // matrix K0 (a KluSolver of its own, so that output samples do not change the factorizations
+  // the integration's own solves see), from x extrapolated through the last output samples
+  // (quadratic in t), accepted when the estimated error of a and of lambda is below `tolerance`
+  // times their max norms; else the direct solve of accelerations(). Samples come in increasing
+  // t; a call of accelerations() (a restart, possibly over a discontinuity) starts the
+  // extrapolation afresh. docs/performance.md has the measurements.
   bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,
                             double t, double* a, double tolerance);
   static constexpr int kMaxRefinements = 4;
@@ -56,8 +57,10 @@ class AugmentedSolver {
   void assemble(const double* q, bool with_mass, double regularization = 0.0);
   // A value pass of assemble() into values_ (checked against the recorded pattern).
   void assemble_values(const double* q, bool with_mass, double regularization = 0.0);
-  bool solve_accelerations(KluSolver& klu, const std::vector<char>& modes, const double* q, const double* v, double t);
-  void assemble_acceleration_system(const std::vector<char>& modes, const double* q, const double* v, double t);
+  bool solve_accelerations(KluSolver& klu, const std::vector<char>& modes, const double* q,
+                           const double* v, double t);
+  void assemble_acceleration_system(const std::vector<char>& modes, const double* q,
+                                    const double* v, double t);
   void predict_accelerations(double t, double* x) const;
   bool refine_accelerations(double t, double tolerance);
   void remember_output(double t);
