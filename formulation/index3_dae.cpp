@@ -38,15 +38,23 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
   const double noise = position_noise(y);
   const double av = atol + noise / h, al = mass_scale_ * (atol + noise / (h * h));
   if (per_unit_step_ && abs_tol_.set()) {
-    // Error per unit step: q's tolerances times step / T, not below the rounding noise.
     state_weights(h, y, rtol, atol, w);
-    const double f = std::fmax(1.0, abs_tol_.time / newton_step(h));
-    for (int i = 0; i < nq_; ++i) w[i] = std::fmin(w[i] * f, std::fmax(w[i], 1.0 / noise));
+    velocity_error_per_unit_step(newton_step(h), y, w);
   } else {
     position_weights(y, rtol, position_atol(y, atol), w);
   }
   for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
+}
+
+void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* w) const {
+  // Tolerances of q times (h/T)^2, never below the rounding of the coordinates (1e3 eps of the
+  // model's positions, 1e3 eps for Euler parameters), never looser than the plain test.
+  const double r = abs_tol_.time / h, f = std::fmax(1.0, r * r);
+  double rmax = abs_tol_.length;
+  for (int i = 0; i < nq_; i += 7) rmax = std::fmax(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
+  const double w_length = 1.0 / (kRoundingFloor * rmax), w_rotation = 1.0 / kRoundingFloor;
+  for (int i = 0; i < nq_; ++i) w[i] = std::fmin(w[i] * f, std::fmax(w[i], i % 7 < 3 ? w_length : w_rotation));
 }
 
 void Index3Dae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {

@@ -4,7 +4,7 @@
 //   F2 = M(q) v' + Phi_q^T lambda - Q(q, v, t)   = 0
 //   F3 = s Phi(q, t)                             = 0
 // Only q is in the local error test (v and lambda are left out, IDASetId + IDASetSuppressAlg),
-// per unit step by default (see error_weights).
+// with the velocity error per unit step by default (see error_weights).
 // The constraint rows are scaled by s = m_ref / h_ref^2 so that they are of the size of the
 // cj^2 M rows of the Newton matrix at the typical step h_ref.
 // The Jacobian dF/dy + cj dF/dy' is exact: it includes d(M v')/dq, the gyroscopic derivatives,
@@ -22,27 +22,29 @@ namespace mbdae {
 
 class Index3Dae : public MultibodyDae {
  public:
-  // velocities_in_error_test: formulation "index3" (true) or "index3-positions" (false).
-  explicit Index3Dae(const System& sys, double constraint_scale = 1.0, bool velocities_in_error_test = true);
+  // velocity_error_per_unit_step: formulation "index3" (true) or "index3-positions" (false).
+  explicit Index3Dae(const System& sys, double constraint_scale = 1.0, bool velocity_error_per_unit_step = true);
 
   int size() const override { return 2 * nq_ + nc_; }
   int residual(double t, const double* y, const double* yp, double* r) override;
   void error_test_mask(double* id) const override;
-  // Weights of the error test and the Newton convergence test. Positions: with error per unit
-  // step (formulation "index3", docs/formulation.md "Error control"), the tolerances in model
-  // units times h/T (T the model's time scale): at index 3, v is the BDF derivative of q, and a
-  // local position error d gives a velocity error of about d/h, which then moves the positions
-  // for the rest of the run; h/T keeps that velocity error below rtol L/T. The tolerance is never
-  // below the rounding noise of the positions (nor looser than the plain test). Without (index3-positions): rtol|q| + atol.
-  // Velocities and multipliers are out of the error test; rounding in the position-level constraints (eps) reaches them as eps/h and eps/h^2,
-  // so their tolerances are those of the positions divided by h and h^2 (Hairer and Wanner,
-  // Solving ODEs II, VII.3): rtol|v| + atol/h and rtol|lambda| + m_ref atol/h^2.
+  // Weights of the error test and the Newton convergence test. Positions: with the velocity
+  // error per unit step (formulation "index3", docs/formulation.md "Error control"), the
+  // tolerances in model units times (h/T)^2, T the model's time scale: at index 3, v is the BDF
+  // derivative of q, a local position error d gives a velocity error of about d/h, and (h/T)^2
+  // keeps that below the velocity tolerance times h/T, so that the velocity errors of the steps
+  // add up to about the velocity tolerance over T. Never below the rounding of the coordinates,
+  // never looser than the plain test. Without (index3-positions): rtol|q| + atol.
+  // Velocities and multipliers are out of the error test; rounding in the position-level
+  // constraints (eps) reaches them as eps/h and eps/h^2, so their tolerances are those of the
+  // positions divided by h and h^2 (Hairer and Wanner, Solving ODEs II, VII.3):
+  // rtol|v| + atol/h and rtol|lambda| + m_ref atol/h^2.
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
 
   // Consistent initial values from the q and v in y: positions and velocities projected onto
   // the constraints, accelerations and multipliers solved; y' = [v, v', 0].
   void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) override;
-  bool velocities_error_tested() const override { return v_in_test_; }
+  bool velocities_error_tested() const override { return false; }
   // Output velocities from the interpolant of v (through the steps' velocities, one degree
   // higher than the derivative of the positions' interpolant, and measured more accurate:
   // spring-body energy 9.6e-9 against 1.6e-8).
@@ -51,8 +53,11 @@ class Index3Dae : public MultibodyDae {
  private:
   void assemble(double t, double cj, const double* y, const double* yp) override;
   double scale_;
+  // The position weights w (nq values) of the velocity error per unit step at step h.
+  void velocity_error_per_unit_step(double h, const double* y, double* w) const;
+  // Rounding floor of the tested coordinates, relative to the model's positions (1e3 eps).
+  static constexpr double kRoundingFloor = 1e3 * 2.220446049250313e-16;
   bool per_unit_step_;
-  bool v_in_test_;
 };
 
 }  // namespace mbdae

@@ -30,6 +30,7 @@ namespace mbdae {
 struct AbsoluteTolerances {
   double position = 0, rotation = 0, velocity = 0, rotation_rate = 0;
   double time = 1;  // [s] the model's time scale (velocity scale length / time)
+  double length = 1;  // [m] the model's length scale
   bool set() const { return position > 0; }
 };
 

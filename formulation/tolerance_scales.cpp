@@ -69,6 +69,7 @@ AbsoluteTolerances absolute_tolerances(const ModelScales& s, double position_ato
   a.velocity = position_atol / s.time;
   a.rotation_rate = a.rotation / s.time;
   a.time = s.time;
+  a.length = s.length;
   return a;
 }
 

@@ -1,8 +1,11 @@
 // The model's length and time scales and the defaults they give (formulation/tolerance_scales.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
+#include "formulation/index3_dae.h"
 #include "formulation/system.h"
 #include "formulation/tests/test_models.h"
 #include "formulation/tolerance_scales.h"
@@ -45,6 +48,40 @@ TEST(ToleranceScales, SpanAndSpring) {
   const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 3.0);
   EXPECT_NEAR(s.fast_time, std::sqrt(2.0 / 800.0), 1e-15);
   EXPECT_NEAR(default_baumgarte_rate(s), 100.0, 1e-9);
+}
+
+// index3's velocity error per unit step: the positions' weights are the plain ones times
+// (T/h)^2, capped at the rounding of the model's positions (1e3 eps max(L, |r|)) and of the
+// Euler parameters (1e3 eps); index3-positions keeps the plain weights.
+TEST(ToleranceScales, Index3VelocityErrorPerUnitStep) {
+  Model m = testing::pendulum(2.0, 0.03, 0.1, 0.0);
+  m.gravity = Vec3(0, 0, -9.81);
+  const System sys = build_system(m);
+  const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 1.0);
+  const double rtol = 1e-6;
+  const AbsoluteTolerances a = absolute_tolerances(s, default_position_atol(s, rtol));
+  Index3Dae unit_step(sys, 1.0, true), plain(sys, 1.0, false);
+  unit_step.set_absolute_tolerances(a);
+  plain.set_absolute_tolerances(a);
+  std::vector<double> y(unit_step.size(), 0.0);
+  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
+  std::vector<double> w(y.size()), w0(y.size());
+  double rmax = 0;
+  for (int i = 0; i < 3; ++i) rmax += std::fabs(y[i]);
+  const double floor_length = 1e3 * 2.220446049250313e-16 * std::max(s.length, rmax);
+  const double floor_rotation = 1e3 * 2.220446049250313e-16;
+  plain.error_weights(1e-3, y.data(), rtol, a.position, w0.data());
+  for (int i = 0; i < 7; ++i) EXPECT_DOUBLE_EQ(w0[i], 1.0 / (rtol * std::fabs(y[i]) + a.position));
+  // h = T / 10: the weights times 100, above the floor.
+  const double h = s.time / 10;
+  unit_step.error_weights(h, y.data(), rtol, a.position, w.data());
+  for (int i = 0; i < 7; ++i) {
+    const double plain_w = 1.0 / (rtol * std::fabs(y[i]) + (i < 3 ? a.position : a.rotation));
+    EXPECT_NEAR(w[i], 100 * plain_w, 1e-9 * w[i]) << i;
+  }
+  // h = T / 1e6: (T/h)^2 = 1e12 would ask for less than the rounding: the floor.
+  unit_step.error_weights(s.time / 1e6, y.data(), rtol, a.position, w.data());
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(w[i], 1.0 / (i < 3 ? floor_length : floor_rotation), 1e-9 * w[i]) << i;
 }
 
 }  // namespace

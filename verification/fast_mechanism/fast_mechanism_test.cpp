@@ -35,42 +35,55 @@ Result run_fast(const Scene& scene, const std::string& formulation) {
   return run(scene, opt);
 }
 
-// Every formulation at the scene's default tolerances (rtol 1e-6, atol from the model's scales)
-// against the reference. The promise, 10 rtol of each quantity's scale, is NOT met on this
-// case by any formulation (measured 3.8e-5 to 5.5e-4 relative, docs/work-precision.md): the
-// crank's phase error grows with omega t. Asserted: 3 correct digits of every position and
-// velocity at 1100 rad/s, and the error estimate says that the promise is missed.
-class FastMechanismFormulation : public ::testing::TestWithParam<std::string> {};
-
-TEST_P(FastMechanismFormulation, DefaultTolerancesGiveThreeDigits) {
-  const Scene scene = load_fast_mechanism();
-  const Result r = run_fast(scene, GetParam());
+// The promise at the scene's default tolerances (rtol 1e-6, atol from the model's
+// scales): every position and velocity within 10 rtol of its scale (the largest |x_ref|).
+// index3 (velocity error per unit step) meets it (measured 6.5e-8 and 1.3e-7 relative,
+// docs/work-precision.md); the other formulations test local errors per step and miss it (the
+// crank's phase error grows with omega t: 3.8e-5 to 8.5e-4 relative): for them 3 correct digits
+// of every position and velocity at 1100 rad/s are asserted, and the error estimate says that
+// the promise is missed.
+void expect_within(const Scene& scene, const std::string& formulation, double factor) {
+  const Result r = run_fast(scene, formulation);
   ASSERT_TRUE(r.ok()) << r.message;
   const FastMechanismErrors e = fast_mechanism_errors(r);
-  const double rtol = scene.steps.back().rtol;
   for (size_t k = 0; k < e.sensors.size(); ++k)
-    EXPECT_LE(e.error[k], 1e-3 * e.scale[k])
-        << GetParam() << ": " << e.sensors[k] << " error " << e.error[k] << " on a scale of " << e.scale[k];
-  std::printf("%s: relative errors positions %.3g, velocities %.3g (%.0f and %.0f rtol)\n", GetParam().c_str(),
+    EXPECT_LE(e.error[k], factor * e.scale[k])
+        << formulation << ": " << e.sensors[k] << " error " << e.error[k] << " on a scale of " << e.scale[k];
+  const double rtol = scene.steps.back().rtol;
+  std::printf("%s: relative errors positions %.3g, velocities %.3g (%.3g and %.3g rtol)\n", formulation.c_str(),
               e.position, e.velocity, e.position / rtol, e.velocity / rtol);
 }
 
-INSTANTIATE_TEST_SUITE_P(Formulations, FastMechanismFormulation,
-                         ::testing::Values("index3", "index2-ggl", "index1", "penalty"));
+TEST(FastMechanism, Index3KeepsThePromiseAtDefaultTolerances) {
+  const Scene scene = load_fast_mechanism();
+  expect_within(scene, "index3", 10 * scene.steps.back().rtol);
+}
 
-// Error per unit step (index3) against the positions-only test (index3-positions): measured 28x.
+class FastMechanismFormulation : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FastMechanismFormulation, DefaultTolerancesGiveThreeDigits) {
+  expect_within(load_fast_mechanism(), GetParam(), 1e-3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formulations, FastMechanismFormulation,
+                         ::testing::Values("index2-ggl", "index1", "penalty"));
+
+// Velocity error per unit step (index3) against the positions-only test (index3-positions):
+// measured 2.3e5 times smaller errors.
 TEST(FastMechanism, Index3ErrorPerUnitStepBeatsPositionsOnly) {
   const Scene scene = load_fast_mechanism();
   const FastMechanismErrors unit_step = fast_mechanism_errors(run_fast(scene, "index3"));
   const FastMechanismErrors positions = fast_mechanism_errors(run_fast(scene, "index3-positions"));
-  EXPECT_LT(10 * unit_step.position, positions.position);
-  EXPECT_LT(10 * unit_step.velocity, positions.velocity);
+  EXPECT_LT(1000 * unit_step.position, positions.position);
+  EXPECT_LT(1000 * unit_step.velocity, positions.velocity);
 }
 
-// The error estimate (cases/error_estimate.h) finds the error within a factor 3 and warns.
+// The error estimate (cases/error_estimate.h) finds the error of a formulation that misses the
+// promise (index2-ggl) within a factor 3 and warns.
 TEST(FastMechanism, ErrorEstimateSeesTheMissedPromise) {
   const Scene scene = load_fast_mechanism();
   RunOptions opt;
+  opt.formulation = "index2-ggl";
   const Result r = run(scene, opt);
   ASSERT_TRUE(r.ok());
   const FastMechanismErrors truth = fast_mechanism_errors(r);

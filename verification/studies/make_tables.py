@@ -175,7 +175,44 @@ def work_precision(args):
             parts.append("Tolerance proportionality, d log(err_z) / d log(tau) over the successful runs: " +
                          "; ".join(slopes) + " (1 is ideal).")
         parts.append("")
+    if args.promise:
+        parts.extend(promise_tables(args.promise))
     replace_block(args.doc, "\n".join(parts), "# Work-precision")
+
+
+def promise_tables(path):
+    """The tolerance's promise (run_promise.sh): one table over every case and formulation."""
+    rows = list(csv.DictReader(open(path)))
+    parts = ["### The tolerance's promise: default tolerances, every case, every formulation", "",
+             "![the tolerance's promise](studies/promise.png)", "",
+             "Runs at the model's default absolute tolerances (the scene's rtol and atol removed), rtol as given. "
+             "Errors: the largest |x - x_ref| over the output samples, of every position sensor (m, rad) and every "
+             "velocity sensor (m/s, rad/s), divided by the quantity's scale (the largest |x_ref| of the sensors of "
+             "its unit; fast mechanism: of the sensor), the worst sensor named. References: index2-ggl at "
+             "rtol 1e-11 (`tolerance_promise`; ref. check: its difference from rtol 1e-10), the fast mechanism's "
+             "Lagrange equation (`fast_mechanism_study`; converged to 1e-10). CPU: `cpu_seconds` of the "
+             "integration on a shared machine. Promise: both errors within 10 rtol. Raw data: "
+             "`docs/studies/promise.csv`.", "",
+             "| case | formulation | rtol | steps | residual evals | CPU [s] | position error / scale | "
+             "velocity error / scale | ratio to rtol (pos, vel) | worst sensors | within 10 rtol |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ok = r["status"] == "ok"
+        tol, ep, ev = fnum(r["rtol"]), fnum(r["err_pos"]), fnum(r["err_vel"])
+        within = ok and ep is not None and ev is not None and ep <= 10 * tol and ev <= 10 * tol
+        ratio = "%s, %s" % (g(ep / tol, 2), g(ev / tol, 2)) if ok and ep is not None and ev is not None else ""
+        verdict = "yes" if within else ("**no**" if ok else "**failed**: " + md_escape(r["status"]))
+        parts.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s, %s | %s |" % (
+            r["case"], r["formulation"], r["rtol"], r["steps"], r["residual_evals"], g(fnum(r["cpu_seconds"])),
+            g(ep), g(ev), ratio, r["worst_pos"], r["worst_vel"], verdict))
+    checks = {}
+    for r in rows:
+        checks.setdefault(r["case"], (r["ref_check_pos"], r["ref_check_vel"]))
+    parts.append("")
+    parts.append("Reference checks (positions, velocities, relative to the scales): " +
+                 "; ".join("%s %s, %s" % (c, p, v) for c, (p, v) in checks.items()) + ".")
+    parts.append("")
+    return parts
 
 
 # ------------------------------------------------------------------------------------------------
@@ -353,6 +390,7 @@ def main():
     w = sub.add_parser("work-precision")
     w.add_argument("--doc", required=True)
     w.add_argument("--study", action="append", required=True, help="path without extension of NAME.csv/.json")
+    w.add_argument("--promise", help="promise.csv of run_promise.sh")
     c = sub.add_parser("extreme-case")
     c.add_argument("--name", required=True)
     c.add_argument("--scene", required=True)

@@ -31,7 +31,7 @@ while [ $# -gt 0 ]; do
 done
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j2 --target mbdae work_precision
+cmake --build "$build" -j2 --target mbdae work_precision tolerance_promise fast_mechanism_study
 wp="$build/verification/studies/work_precision"
 out="$root/docs/studies"
 mkdir -p "$out"
@@ -52,8 +52,11 @@ echo "== work-precision: Dynamics II (three tolerances, one repetition)"
 /usr/bin/python3 "$here/plot_work_precision.py" "$out/wp_dynamics_poster.csv" "$out/wp_dynamics_poster.png" \
   --meta "$out/wp_dynamics_poster.json"
 
+echo "== the tolerance's promise: default tolerances, every case, every formulation"
+"$here/run_promise.sh"
+
 /usr/bin/python3 "$here/make_tables.py" work-precision --doc "$root/docs/work-precision.md" \
-  --study "$out/wp_dynamics_step" --study "$out/wp_dynamics_poster"
+  --study "$out/wp_dynamics_step" --study "$out/wp_dynamics_poster" --promise "$out/promise.csv"
 echo "tables written into docs/work-precision.md"
 
 if [ "$extreme" = 1 ]; then

@@ -156,11 +156,13 @@ def test_a_worker_killed_during_the_sweep_does_not_lose_its_task(client, tmp_pat
 
 def test_work_precision_table(client, tmp_path):
     scene = mbdae.load(STEP)
-    reference = scene.run(formulation="index3", rtol=1e-11, atol=1e-15)
-    table = mbdae.work_precision(scene, ["index3", "index1"], [1e-5, 1e-8], columns=["wheel_z"], reference=reference,
+    # index2-ggl: index3's velocity error per unit step reaches its rounding floor (about 1e-9 m
+    # here) from tau 1e-5 on, also at rtol 1e-11.
+    reference = scene.run(formulation="index2-ggl", rtol=1e-11, atol=1e-15)
+    table = mbdae.work_precision(scene, ["index3", "index1"], [1e-3, 1e-5], columns=["wheel_z"], reference=reference,
                                  out=tmp_path, client=client)
     assert list(table["formulation"]) == ["index3", "index3", "index1", "index1"]
-    assert list(table["atol"]) == [1e-6 * tau for tau in (1e-5, 1e-8, 1e-5, 1e-8)] and (table["status"] == "ok").all()
+    assert list(table["atol"]) == [1e-6 * tau for tau in (1e-3, 1e-5, 1e-3, 1e-5)] and (table["status"] == "ok").all()
     for i, row in table.iterrows():
         alone = scene.run(formulation=row["formulation"], rtol=row["rtol"], atol=row["atol"])
         assert row["err_wheel_z"] == np.max(np.abs(alone["wheel_z"] - reference["wheel_z"]))
