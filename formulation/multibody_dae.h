@@ -170,6 +170,10 @@ class MultibodyDae : public DaeProblem {
   double mass_scale_ = 1e-3;  // largest body mass (multipliers are forces: mass-scaled weights)
   double segment_end_ = 1e300;
   std::vector<int> switch_forces_;
+  // Per switching function, its value at the last restart where that value disagreed with the
+  // mode (else 0): the root function is g - offset, so that the next crossing is seen (restart).
+  std::vector<double> switch_offsets_;
+  void set_switch_offsets(double t, const double* y);
   AugmentedSolver aug_;
   std::vector<double> stat_work_, out_phi_;
   long condition_samples_ = 0;

@@ -205,6 +205,34 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
   for (size_t i = 0; i < ev8.size(); ++i) EXPECT_NEAR(ev8[i].get<double>(), ev10[i].get<double>(), 1e-6);
 }
 
+// Dynamics II at a loose tolerance (index2-ggl, rtol 1e-4, the model's default atol). The state
+// at a tyre-contact event is a converged step onto the root time and can lie a local error on the
+// other side of the switch: before the root functions were shifted there
+// (MultibodyDae::set_switch_offsets) the wheel was set free 5.5e-6 m below the ground at 14.66 s,
+// never saw the contact function cross zero again, and fell 140 m with status ok. Compared with
+// the scene's own run (index3, rtol 1e-7): measured 7.2e-4 m, asserted below 100 rtol of wheel_z's
+// scale (0.28 m): index2-ggl misses the 10 rtol promise here (docs/work-precision.md).
+TEST(Suspension, LooseToleranceKeepsTheWheelOnTheGround) {
+  const Scene tight = load_scene(scene_path("dynamics_poster.yaml"));
+  Scene loose = tight;
+  for (AnalysisStep& s : loose.steps) {
+    s.rtol = 1e-4;
+    s.atol = 0;  // derived from the model's length scale
+    s.formulation = "index2-ggl";
+  }
+  RunOptions o;
+  o.verbose = false;
+  o.progress = false;
+  const Result a = mbdae::run(loose, o), b = mbdae::run(tight, o);
+  ASSERT_EQ(a.exit_code, 0);
+  ASSERT_EQ(b.exit_code, 0);
+  const double e = max_difference(a, b, "wheel_z");
+  RecordProperty("wheel_z_difference", std::to_string(e));
+  EXPECT_LT(e, 100 * 1e-4 * 0.28);
+  const std::vector<double>& z = a.column("wheel_z");
+  EXPECT_GT(*std::min_element(z.begin(), z.end()), 0.2);
+}
+
 // The source's "ball cut 5" repeats the tree joint rod 5 - carrier: its three equations are
 // flagged as redundant by name (fail policy), or removed (default) with the same assembly.
 TEST(Suspension, BallCut5IsFlaggedAsRedundant) {
