@@ -5,6 +5,10 @@
 
 namespace mbdae {
 
+namespace {
+constexpr double kMaxTransversalWork = 100;  // times nnz(A): KLU's maxwork for btf_maxtrans
+}  // namespace
+
 KluSolver::KluSolver() { klu_defaults(&common_); }
 
 KluSolver::~KluSolver() {
@@ -24,18 +28,22 @@ bool KluSolver::analyze(const CscPattern& p) {
 }
 
 // Symbolic analysis; with BTF requested, also without it, keeping the analysis without BTF when
-// it predicts at least 20 % less fill (within that margin the orders cost the same, and the pivot
+// BTF's maximum transversal gave up at kMaxTransversalWork x nnz(A) work (its cost is not linear
+// in general: 2.1 s on a 200000-unknown binary tree's Newton matrix, docs/scaling.md; an
+// incomplete transversal is never factored), or when it predicts at least 20 % less fill (within that margin the orders cost the same, and the pivot
 // order of every mechanism that does not gain stays as it was). BTF's maximum transversal can pair
 // constraint rows with columns far from them, and partial pivoting on AMD's order of that permuted
 // matrix then fills like N^2 on serial chains (docs/scaling.md).
 bool KluSolver::analyze_pattern() {
   free_numeric();
   if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
+  common_.maxwork = kMaxTransversalWork;
   symbolic_ = klu_analyze(pattern_.rows, pattern_.colptr.data(), pattern_.rowind.data(), &common_);
   if (symbolic_ == nullptr || !common_.btf) return symbolic_ != nullptr;
+  const bool transversal_cut = common_.work < 0;  // BTF's maximum transversal hit maxwork
   common_.btf = 0;
   klu_symbolic* plain = klu_analyze(pattern_.rows, pattern_.colptr.data(), pattern_.rowind.data(), &common_);
-  if (plain && 1.2 * (plain->lnz + plain->unz) <= symbolic_->lnz + symbolic_->unz) {
+  if (plain && (transversal_cut || 1.2 * (plain->lnz + plain->unz) <= symbolic_->lnz + symbolic_->unz)) {
     klu_free_symbolic(&symbolic_, &common_);
     symbolic_ = plain;
     return true;
@@ -45,7 +53,7 @@ bool KluSolver::analyze_pattern() {
   return true;
 }
 
-// Fresh klu_factor. If partial pivoting filled L + U to more than twice the fill that the
+// Fresh klu_factor. If partial pivoting filled L + U to more than 1.5 times the fill that the
 // ordering predicted, the pivots have left the ordering's diagonal (BTF's maximum transversal
 // matched rows to columns that the fill-reducing order does not respect; docs/scaling.md): the
 // pattern is analyzed again without BTF, as AMD on the matrix's own diagonal, and factored again.
@@ -55,7 +63,7 @@ bool KluSolver::factor_fresh() {
                         &common_);
   if (numeric_ == nullptr || common_.status != KLU_OK) return false;
   const double predicted = symbolic_->lnz + symbolic_->unz;
-  if (common_.btf && numeric_->lnz + numeric_->unz > 2 * predicted) {
+  if (common_.btf && numeric_->lnz + numeric_->unz > 1.5 * predicted) {
     common_.btf = 0;
     if (!analyze_pattern()) return false;
     return factor_fresh();

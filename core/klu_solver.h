@@ -1,7 +1,7 @@
 // Sparse LU by SuiteSparse KLU: symbolic analysis once per pattern, numeric factorization
 // (klu_factor) the first time and klu_refactor (same pivot order) afterwards, falling back to a
 // fresh factorization when the reused pivots degrade (pivot ratio below 1e-14 and below 1e-3 of
-// the fresh one's). A fresh factorization whose fill exceeds twice the ordering's prediction
+// the fresh one's). A fresh factorization whose fill exceeds 1.5 times the ordering's prediction
 // redoes the analysis without BTF once (KluSolver::factor_fresh).
 #pragma once
 
@@ -26,6 +26,8 @@ class KluSolver {
   bool factor(const double* values);
   // Solves A x = b in place.
   bool solve(double* b);
+  // Whether a factorization is held (solve can be called).
+  bool factored() const { return numeric_ != nullptr; }
   // Reciprocal condition estimate of the last factorization.
   double rcond();
   // 1-norm condition number estimate of the last factorized matrix (klu_condest).

@@ -22,6 +22,7 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   rhs_.resize(n);
   work_.resize(n);
   work2_.resize(n);
+  for (auto& h : history_) h.resize(n);
 }
 
 void AugmentedSolver::assemble(const double* q, bool with_mass, double regularization) {
@@ -43,19 +44,123 @@ void AugmentedSolver::assemble_values(const double* q, bool with_mass, double re
 
 bool AugmentedSolver::accelerations(const std::vector<char>& modes, const double* q,
                                     const double* v, double t, double* a, double* lambda) {
-  assemble_values(q, true);
-  check_overflow(values_.data(), static_cast<int>(values_.size()), t, "the mass matrix entries",
-                 "a mass or an inertia");
-  if (!klu_.factor(values_.data())) return false;
-  generalized_forces(sys_, modes, q, v, t, rhs_.data());
-  check_overflow(rhs_.data(), nq_, t, "the applied forces", "a mass, gravity or a force");
-  constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
-  if (!klu_.solve(rhs_.data())) return false;
-  check_overflow(rhs_.data(), nq_ + nc_, t, "the accelerations and constraint forces",
-                 "a force against a small mass or inertia");
+  history_size_ = 0;
+  if (!solve_accelerations(klu_, modes, q, v, t)) return false;
   std::copy(rhs_.begin(), rhs_.begin() + nq_, a);
   if (lambda) std::copy(rhs_.begin() + nq_, rhs_.end(), lambda);
   return true;
+}
+
+// K = [M Phi_q^T; Phi_q 0] into values_, b = [Q; gamma] into rhs_.
+void AugmentedSolver::assemble_acceleration_system(const std::vector<char>& modes, const double* q,
+                                                   const double* v, double t) {
+  assemble_values(q, true);
+  check_overflow(values_.data(), static_cast<int>(values_.size()), t, "the mass matrix entries",
+                 "a mass or an inertia");
+  generalized_forces(sys_, modes, q, v, t, rhs_.data());
+  check_overflow(rhs_.data(), nq_, t, "the applied forces", "a mass, gravity or a force");
+  constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
+}
+
+// The direct solve with `klu`: [a; lambda] into rhs_.
+bool AugmentedSolver::solve_accelerations(KluSolver& klu, const std::vector<char>& modes, const double* q,
+                                          const double* v, double t) {
+  assemble_acceleration_system(modes, q, v, t);
+  if (!klu.factor(values_.data())) return false;
+  if (!klu.solve(rhs_.data())) return false;
+  check_overflow(rhs_.data(), nq_ + nc_, t, "the accelerations and constraint forces",
+                 "a force against a small mass or inertia");
+  return true;
+}
+
+void AugmentedSolver::prepare_output_accelerations() {
+  if (!output_prepared_) output_prepared_ = klu_output_.analyze(asm_.pattern());
+}
+
+bool AugmentedSolver::output_accelerations(const std::vector<char>& modes, const double* q,
+                                           const double* v, double t, double* a, double tolerance) {
+  if (!output_prepared_) return accelerations(modes, q, v, t, a, nullptr);
+  if (history_size_ > 0 && !(t > history_t_[0])) history_size_ = 0;
+  bool refined = false;
+  if (klu_output_.factored() && history_size_ > 0) {
+    assemble_acceleration_system(modes, q, v, t);
+    refined = refine_accelerations(t, tolerance);  // the solution into rhs_
+  }
+  if (!refined && !solve_accelerations(klu_output_, modes, q, v, t)) return false;
+  ++(refined ? refinement.refined : refinement.direct);
+  remember_output(t);
+  std::copy(rhs_.begin(), rhs_.begin() + nq_, a);
+  return true;
+}
+
+void AugmentedSolver::remember_output(double t) {
+  std::rotate(std::begin(history_), std::begin(history_) + 2, std::end(history_));
+  std::copy_backward(std::begin(history_t_), std::begin(history_t_) + 2, std::end(history_t_));
+  history_[0].assign(rhs_.begin(), rhs_.end());  // same size: no allocation
+  history_t_[0] = t;
+  history_size_ = std::min(history_size_ + 1, 3);
+}
+
+// Lagrange extrapolation to t through the remembered samples (constant, linear or quadratic).
+void AugmentedSolver::predict_accelerations(double t, double* x) const {
+  const int m = history_size_;
+  double w[3] = {1, 0, 0};
+  for (int i = 0; i < m; ++i) {
+    w[i] = 1;
+    for (int j = 0; j < m; ++j)
+      if (j != i) w[i] *= (t - history_t_[j]) / (history_t_[i] - history_t_[j]);
+  }
+  const int n = nq_ + nc_;
+  for (int k = 0; k < n; ++k) {
+    double s = 0;
+    for (int i = 0; i < m; ++i) s += w[i] * history_[i][k];
+    x[k] = s;
+  }
+}
+
+// From the extrapolated x: r = b - K x (K in values_, b in rhs_), dx = K0^-1 r, x += dx. The
+// iteration contracts by rho = |K0^-1 (K - K0)| per correction (small for nearby states); the
+// error left after a correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio
+// of successive corrections (per block, a and lambda). Accepted when that estimate is below
+// `tolerance` of the block's max norm; a slow (rho > 0.5) or diverging iteration is not.
+bool AugmentedSolver::refine_accelerations(double t, double tolerance) {
+  const CscPattern& p = asm_.pattern();
+  const int n = nq_ + nc_;
+  double* x = work2_.data();
+  predict_accelerations(t, x);
+  double last_dx[2] = {0, 0};
+  for (int it = 0; it < kMaxRefinements; ++it) {
+    std::copy(rhs_.begin(), rhs_.end(), work_.begin());
+    for (int j = 0; j < n; ++j)
+      for (int k = p.colptr[j]; k < p.colptr[j + 1]; ++k) work_[p.rowind[k]] -= values_[k] * x[j];
+    if (!klu_output_.solve(work_.data())) return false;
+    ++refinement.corrections;
+    double dx[2] = {0, 0}, xmax[2] = {0, 0};
+    for (int i = 0; i < n; ++i) {
+      x[i] += work_[i];
+      const int b = i >= nq_;
+      dx[b] = std::fmax(dx[b], std::fabs(work_[i]));
+      xmax[b] = std::fmax(xmax[b], std::fabs(x[i]));
+    }
+    if (!std::isfinite(dx[0] + dx[1] + xmax[0] + xmax[1])) return false;
+    bool converged = true, hopeless = false;
+    for (int b = 0; b < 2; ++b) {
+      const double rho = it > 0 && last_dx[b] > 0 ? dx[b] / last_dx[b] : 1.0;
+      const double error = rho <= 0.5 ? rho / (1 - rho) * dx[b] : INFINITY;
+      converged = converged && (dx[b] == 0 || error <= tolerance * xmax[b]);
+      // Not within the corrections left at this rate: the direct solve is cheaper.
+      hopeless = hopeless || (it > 0 && error * std::pow(rho, kMaxRefinements - 1 - it) > tolerance * xmax[b]);
+      last_dx[b] = dx[b];
+    }
+    if (hopeless && !converged) return false;
+    if (converged) {
+      check_overflow(x, n, t, "the accelerations and constraint forces",
+                     "a force against a small mass or inertia");
+      std::copy(work2_.begin(), work2_.end(), rhs_.begin());
+      return true;
+    }
+  }
+  return false;
 }
 
 void AugmentedSolver::check_overflow(const double* x, int n, double t, const char* what,
@@ -101,7 +206,7 @@ PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, 
     // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q -eps I] [dq; mu] = [0; -Phi]. With
     // eps > 0 (Levenberg-Marquardt) the step exists also for redundant constraints.
     assemble_values(q, false, regularization);
-    if (!klu_.factor(values_.data())) break;
+      if (!klu_.factor(values_.data())) break;
     std::fill(rhs_.begin(), rhs_.begin() + nq_, 0.0);
     for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -phi[i];
     if (!klu_.solve(rhs_.data())) break;

@@ -29,6 +29,23 @@ class AugmentedSolver {
   // SolveError (status "overflow") if the mass matrix, the forces or the result are not finite.
   bool accelerations(const std::vector<char>& modes, const double* q, const double* v, double t,
                      double* a, double* lambda);
+  // The accelerations of an output sample, without a factorization where one of a nearby state
+  // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration
+  // matrix K0 (a KluSolver of its own, so that output samples do not change the factorizations
+  // the integration's own solves see), from x extrapolated through the last output samples
+  // (quadratic in t), accepted when the estimated error of a and of lambda is below `tolerance`
+  // times their max norms; else the direct solve of accelerations(). Samples come in increasing
+  // t; a call of accelerations() (a restart, possibly over a discontinuity) starts the
+  // extrapolation afresh. docs/performance.md has the measurements.
+  bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,
+                            double t, double* a, double tolerance);
+  static constexpr int kMaxRefinements = 4;
+  // The analysis of that factorization's pattern, outside the step loop (MultibodyDae's
+  // consistent_state); until then output_accelerations is accelerations().
+  void prepare_output_accelerations();
+  struct RefinementStats {  // how output samples were solved (tests, benchmarks)
+    long refined = 0, direct = 0, corrections = 0;
+  } refinement;
   bool velocities(const double* q, double t, double* v);
   PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100,
                                 double regularization = 0.0);
@@ -40,6 +57,13 @@ class AugmentedSolver {
   void assemble(const double* q, bool with_mass, double regularization = 0.0);
   // A value pass of assemble() into values_ (checked against the recorded pattern).
   void assemble_values(const double* q, bool with_mass, double regularization = 0.0);
+  bool solve_accelerations(KluSolver& klu, const std::vector<char>& modes, const double* q,
+                           const double* v, double t);
+  void assemble_acceleration_system(const std::vector<char>& modes, const double* q,
+                                    const double* v, double t);
+  void predict_accelerations(double t, double* x) const;
+  bool refine_accelerations(double t, double tolerance);
+  void remember_output(double t);
   void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
   const System& sys_;
   std::vector<int> offsets_;
@@ -47,6 +71,12 @@ class AugmentedSolver {
   SparseAssembler asm_;
   KluSolver klu_;
   std::vector<double> values_, rhs_, work_, work2_, trial_;
+  KluSolver klu_output_;  // output samples' acceleration matrix K0
+  bool output_prepared_ = false;
+  // The last output solutions [a; lambda] and their times (history_[0] the newest).
+  int history_size_ = 0;
+  double history_t_[3] = {0, 0, 0};
+  std::vector<double> history_[3];
 };
 
 }  // namespace mbdae

@@ -208,6 +208,7 @@ void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, d
                      "initial positions violate the constraints (max " + std::to_string(pr.residual) +
                          "): " + pr.worst);
   if (!aug_.velocities(q, t, v)) throw SolveError("singular", "velocity projection is singular");
+  if (output_accelerations) aug_.prepare_output_accelerations();
   if (!aug_.accelerations(modes, q, v, t, a, lambda))
     throw SolveError("singular",
                      "the augmented mass matrix is singular at t = " + std::to_string(t) +
@@ -265,7 +266,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
       output_failure = buf;
     }
   }
-  if (output_failure.empty() && output_accelerations && !aug_.accelerations(modes, q.data(), v.data(), t, a.data(), nullptr)) {
+  if (output_failure.empty() && output_accelerations && !aug_.output_accelerations(modes, q.data(), v.data(), t, a.data(), output_acceleration_tolerance)) {
     std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the acceleration solve failed (singular augmented matrix)", t_in);
     output_failure = buf;
   }

@@ -89,6 +89,9 @@ class MultibodyDae : public DaeProblem {
   double max_velocity_violation = 0;  // max |Phi_q v + Phi_t| over accepted steps
   // Solve accelerations for output samples (only needed by acceleration sensors).
   bool output_accelerations = true;
+  // Relative error allowed in the output accelerations' linear solve (run(): min(1e-10, 1e-3
+  // rtol), below the integration error they carry at any rtol; AugmentedSolver::output_accelerations).
+  double output_acceleration_tolerance = 1e-12;
   double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
   // Conditioning of the constraints along the run (computed at output samples when
   // track_condition is set: one extra factorization every tenth sample).

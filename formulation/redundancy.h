@@ -1,7 +1,9 @@
 // Redundant constraint equations: rows of the constraint Jacobian that depend linearly on the
 // rows before them. Found by a sparse rank-revealing QR (SuiteSparseQR, Heath's method, columns in
-// their natural order) of Phi_q^T with every row scaled to unit norm, so that the equations
-// reported are the last ones of each dependent set (cuts come after tree joints).
+// a fixed order) of Phi_q^T with every row scaled to unit norm. The order: the tree's equations
+// (Euler norms, tree joints, locks, drives) in a fill-reducing order (CCOLAMD; linear on trees),
+// then cuts and holds in their natural order, so that the equations reported are the last cut
+// equations of each dependent set.
 #pragma once
 
 #include <string>
