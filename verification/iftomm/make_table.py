@@ -473,7 +473,9 @@ NOTES = """
   exactly at the specified state changed the results within the integrators' error: A02 (penalty,
   20 s) B0 error 6.44e-5 m then, 5.80e-5 m now; A05 s error at 10 s 7.7e-10 m then, 1.0e-10 m now.
   The loose-tolerance index-3 A02 row (rtol 1e-6, max_step 1e-3), which completed the 20 s with
-  the prelude (7.49e-3 m), now fails at t = 10.55 s (IDA_CONV_FAIL at a singular configuration).
+  the prelude (7.49e-3 m), failed at t = 10.55 s (IDA_CONV_FAIL at a singular configuration) and,
+  with index3's velocity error per unit step (issue 13), fails at the first crossing (0.72 s), like
+  the tight run.
 - **A02 singular configurations.** At the horizontal configurations (20 in the 20 s) the
   constraint Jacobian loses N more rows of rank (N + 1 instantaneous degrees of freedom: a
   self-stress of the collinear bars, u^T Phi_q = 0, and the mode it stops constraining, the
@@ -482,10 +484,11 @@ NOTES = """
   formulation** (`formulation: penalty`, `formulation/index1_dae.h`, [docs/formulation.md](formulation.md)
   "Singular configurations"): lambda = p (Phi'' + 2 alpha Phi' + beta^2 Phi), whose Newton
   matrix stays regular, with p = 1e7 kg and alpha = beta = 1000/s. It passes all 20 crossings
-  with B0 within 5.8e-5 m of the reference (first row; about 10.6 s CPU), the crank angles equal to
+  with B0 within 5.9e-5 m of the reference (first row; about 8 s CPU), the crank angles equal to
   5e-7 rad and the constraints violated by at most 1.5e-10 m (the penalty's bias). The index-3
   rows show the earlier state: with the earlier scene settings IDA fails (IDA_CONV_FAIL) just
-  before the first crossing, and with loose tolerances it fails later (now at 10.55 s; with the
+  before the first crossing, and with loose tolerances it failed later (at 10.55 s before issue 13's
+  error control, now at the first crossing too; with the
   earlier prelude scene it completed the 20 s) or completes but misses the high-precision
   tolerance (index 3 leaves v out of the error test: the phase drifts). Of 42 index-3 tolerance
   combinations tried earlier with the prelude scenes (rtol 1e-10 ... 1e-6, atol 1e-3 rtol or = rtol, Newton coefficient
