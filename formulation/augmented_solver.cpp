@@ -206,7 +206,7 @@ PositionSolveResult AugmentedSolver::positions(double* q, double t, double tol, 
     // Minimum-norm Gauss-Newton step: [I Phi_q^T; Phi_q -eps I] [dq; mu] = [0; -Phi]. With
     // eps > 0 (Levenberg-Marquardt) the step exists also for redundant constraints.
     assemble_values(q, false, regularization);
-      if (!klu_.factor(values_.data())) break;
+    if (!klu_.factor(values_.data())) break;
     std::fill(rhs_.begin(), rhs_.begin() + nq_, 0.0);
     for (int i = 0; i < nc_; ++i) rhs_[nq_ + i] = -phi[i];
     if (!klu_.solve(rhs_.data())) break;
