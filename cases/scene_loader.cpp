@@ -1077,30 +1077,70 @@ std::optional<std::string> read_text_file(const std::string& path, std::string& 
 
 // The line (1-based) of the '---' that starts the document whose content begins at 0-based line
 // `content` (the last '---' line up to it; the first '---' after line 1 if the document is empty).
-int second_document_line(const std::string& text, int content) {
+// The first line (1-based) with YAML content (not blank, not a comment, not a directive or a
+// document marker) and its text, trimmed and cut at 40 characters; 0 if none.
+int first_content_line(const std::string& text, std::string& content) {
   std::istringstream in(text);
   std::string line;
-  int found = 0;
   for (int k = 0; std::getline(in, line); ++k) {
-    if (content >= 0 && k > content) break;
-    if (line.rfind("---", 0) == 0 && k > 0) {
-      found = k + 1;
-      if (content < 0) break;
-    }
+    if (line.compare(0, 3, "---") == 0 || line.compare(0, 3, "...") == 0 || line.compare(0, 1, "%") == 0) continue;
+    const size_t a = line.find_first_not_of(" \t\r");
+    if (a == std::string::npos || line[a] == '#') continue;
+    const size_t b = line.find_last_not_of(" \t\r");
+    content = line.substr(a, std::min<size_t>(b - a + 1, 40));
+    return k + 1;
   }
-  return found;
+  return 0;
+}
+
+// True if `line` is the document marker `marker` ("---" or "...") at column 0.
+bool document_marker(const std::string& line, const char* marker) {
+  return line.compare(0, 3, marker) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+}
+
+// The line (1-based) where a second YAML document starts in `text`, 0 if none: a start marker
+// ("---") after content, or content after an end marker ("..."). A scan of the text instead of
+// counting yaml-cpp's documents: YAML::LoadAll (yaml-cpp 0.7) never returns on some invalid
+// inputs (a file holding a lone ',' hung `mbdae check`; found by the fuzz target).
+int second_document_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  bool content = false, ended = false;
+  for (int k = 0; std::getline(in, line); ++k) {
+    const bool start = document_marker(line, "---");
+    if (start && (content || ended)) return k + 1;
+    if (document_marker(line, "...")) {
+      ended = ended || content;
+      continue;
+    }
+    const std::string rest = start ? line.substr(3) : line;
+    const size_t first = rest.find_first_not_of(" \t\r");
+    const bool blank = first == std::string::npos || rest[first] == '#' || (!start && rest[0] == '%');
+    if (blank) continue;
+    if (ended) return k + 1;
+    content = true;
+  }
+  return 0;
 }
 
 std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
   try {
     // One document per file: a second one (after '---') would be silently ignored by YAML::Load.
-    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
-    if (docs.size() > 1) {
-      issues.push_back({path, second_document_line(text, docs[1].Mark().line), "",
+    if (const int second = second_document_line(text)) {
+      issues.push_back({path, second, "",
                         "a second YAML document ('---') is not read; a scene or model file holds one document"});
       return std::nullopt;
     }
-    return docs.empty() ? YAML::Node() : docs[0];
+    const YAML::Node root = YAML::Load(text);
+    // yaml-cpp returns an empty document for some invalid text (a lone ','): say so instead of
+    // "the scene is empty".
+    std::string first;
+    const int line = first_content_line(text, first);
+    if (root.IsNull() && line > 0 && first != "~" && first != "null" && first != "Null" && first != "NULL") {
+      issues.push_back({path, line, "", "YAML syntax error: no YAML value could be read from '" + first + "'"});
+      return std::nullopt;
+    }
+    return root;
   } catch (const YAML::Exception& e) {
     issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "YAML syntax error: " + e.msg});
     return std::nullopt;

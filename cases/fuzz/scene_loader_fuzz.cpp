@@ -55,7 +55,7 @@ void check_command_line(const std::vector<std::string>& args, const mbdae::Scene
   if (o.rtol != 0 && !(o.rtol >= 1e-14 && o.rtol <= 0.5)) std::abort();
   if (o.atol != 0 && !(o.atol > 0 && o.atol <= 1)) std::abort();
   if (o.output_step != 0 && !(o.output_step > 0)) std::abort();
-  if (o.out_dir.empty()) std::abort();
+  if (!cl.check_only && cl.out_dir.empty()) std::abort();  // run needs --out
   if (!scene || !mbdae::check_overrides(*scene, o).empty() || !(o.output_step > 0)) return;
   for (const auto& s : scene->steps)
     if (mbdae::integrates(s) &&
