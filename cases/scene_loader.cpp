@@ -773,12 +773,9 @@ struct Loader {
       case T::kCoordinate: case T::kCoordinateRate:
         applies(n, what, general, {"name", "type", "coordinate", "wrap"});
         s.target = name(n, "coordinate");
-        if (has(n, "wrap")) {
-          const std::string w = text(n, "wrap", "false");
-          if (w == "true") s.wrap = true;
-          else if (w != "false" && n["wrap"].IsScalar()) error(n["wrap"], "wrap", "expected true or false, got " + quote(w));
-          if (s.type == T::kCoordinateRate) error(n["wrap"], "wrap", "does not apply to a coordinate_rate sensor (rates are not wrapped)");
-        }
+        flag(n, "wrap", s.wrap);
+        if (has(n, "wrap") && s.type == T::kCoordinateRate)
+          error(n["wrap"], "wrap", "does not apply to a coordinate_rate sensor (rates are not wrapped)");
         break;
       case T::kForceLength: case T::kForceValue:
         applies(n, what, general, {"name", "type", "force"});
@@ -813,12 +810,12 @@ struct Loader {
     }
   }
 
-  // A true/false field.
+  // A true/false field (absent: `out` unchanged).
   void flag(const YAML::Node& n, const char* key, bool& out) {
     if (!has(n, key)) return;
     const std::string v = text(n, key, "false");
-    if (v == "true") out = true;
-    else if (v != "false") error(at(n, key), key, "expected true or false, got " + quote(v));
+    if (v == "true" || v == "false") out = v == "true";
+    else if (n[key].IsScalar()) error(n[key], key, "expected true or false, got " + quote(v));
   }
 
   // The time span, tolerances and model scales of a step, each checked against its range.
@@ -915,11 +912,7 @@ struct Loader {
   void animation(const YAML::Node& n, AnimationSpec& a) {
     if (!check_keys(n, "animation", {"write", "frame_rate", "max_frames", "start", "end", "axis_length", "shapes"}))
       return;
-    if (has(n, "write")) {
-      const std::string v = text(n, "write", "false");
-      if (v != "true" && v != "false") error(n["write"], "write", "expected true or false, got " + quote(v));
-      a.write = v == "true";
-    }
+    flag(n, "write", a.write);
     auto positive = [&](const char* key, double& x, bool zero_ok) {
       const auto v = opt_number(n, key);
       if (v && (zero_ok ? *v >= 0 : *v > 0)) x = *v;
@@ -1077,25 +1070,32 @@ std::optional<std::string> read_text_file(const std::string& path, std::string& 
 
 // The line (1-based) of the '---' that starts the document whose content begins at 0-based line
 // `content` (the last '---' line up to it; the first '---' after line 1 if the document is empty).
-// The first line (1-based) with YAML content (not blank, not a comment, not a directive or a
-// document marker) and its text, trimmed and cut at 40 characters; 0 if none.
+// True if `line` is the document marker `marker` ("---" or "...") at column 0.
+bool document_marker(const std::string& line, const char* marker) {
+  return line.compare(0, 3, marker) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+}
+
+// The YAML content of one line, trimmed: the line after a start marker ("---"), empty for a blank
+// line, a comment, a directive ("%") or an end marker ("...").
+std::string line_content(const std::string& line) {
+  if (document_marker(line, "...") || line.compare(0, 1, "%") == 0) return "";
+  const std::string rest = document_marker(line, "---") ? line.substr(3) : line;
+  const size_t a = rest.find_first_not_of(" \t\r");
+  if (a == std::string::npos || rest[a] == '#') return "";
+  return rest.substr(a, rest.find_last_not_of(" \t\r") - a + 1);
+}
+
+// The first line (1-based) with YAML content and that content cut at 40 characters; 0 if none.
 int first_content_line(const std::string& text, std::string& content) {
   std::istringstream in(text);
   std::string line;
   for (int k = 0; std::getline(in, line); ++k) {
-    if (line.compare(0, 3, "---") == 0 || line.compare(0, 3, "...") == 0 || line.compare(0, 1, "%") == 0) continue;
-    const size_t a = line.find_first_not_of(" \t\r");
-    if (a == std::string::npos || line[a] == '#') continue;
-    const size_t b = line.find_last_not_of(" \t\r");
-    content = line.substr(a, std::min<size_t>(b - a + 1, 40));
+    const std::string c = line_content(line);
+    if (c.empty()) continue;
+    content = c.substr(0, 40);
     return k + 1;
   }
   return 0;
-}
-
-// True if `line` is the document marker `marker` ("---" or "...") at column 0.
-bool document_marker(const std::string& line, const char* marker) {
-  return line.compare(0, 3, marker) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
 }
 
 // The line (1-based) where a second YAML document starts in `text`, 0 if none: a start marker
@@ -1113,10 +1113,7 @@ int second_document_line(const std::string& text) {
       ended = ended || content;
       continue;
     }
-    const std::string rest = start ? line.substr(3) : line;
-    const size_t first = rest.find_first_not_of(" \t\r");
-    const bool blank = first == std::string::npos || rest[first] == '#' || (!start && rest[0] == '%');
-    if (blank) continue;
+    if (line_content(line).empty()) continue;
     if (ended) return k + 1;
     content = true;
   }

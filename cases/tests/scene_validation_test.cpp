@@ -192,6 +192,21 @@ TEST(SceneValidation, AnalysisTypesFromTheRegistry) {
   }
 }
 
+// Every true/false field is read by one reader: the same message, and an explicit false wins.
+TEST(SceneValidation, TrueFalseFields) {
+  std::string t = with("coordinate: theta}", "coordinate: theta, wrap: maybe}");
+  expect_one(t, line_of(t, "wrap: maybe"), "wrap", "expected true or false, got 'maybe'");
+  t = with("atol: 1.0e-8}", "atol: 1.0e-8, output_projection: yes}");
+  expect_one(t, line_of(t, "output_projection"), "output_projection", "expected true or false, got 'yes'");
+  t = with("output: [angle, tip_z]", "output: [angle, tip_z]\nanimation: {write: 1}");
+  expect_one(t, line_of(t, "write: 1"), "write", "expected true or false, got '1'");
+  EXPECT_TRUE(load_scene_text(with("output: [angle, tip_z]", "output: [angle, tip_z]\nanimation: {write: true}"),
+                              kFile).animation.write);
+  EXPECT_FALSE(load_scene_text(with("output: [angle, tip_z]", "output: [angle, tip_z]\nanimation: {write: false}"),
+                               kFile).animation.write);
+  EXPECT_TRUE(load_scene_text(with("coordinate: theta}", "coordinate: theta, wrap: true}"), kFile).model.sensors[0].wrap);
+}
+
 TEST(SceneValidation, WrongTypeNumber) {
   const std::string t = with("mass: 0.5", "mass: heavy");
   expect_one(t, line_of(t, "heavy"), "mass", "expected a number, got 'heavy'");
