@@ -28,6 +28,10 @@ class DaeProblem {
     for (int i = 0; i < size(); ++i) w[i] = 1.0 / (rtol * (y[i] < 0 ? -y[i] : y[i]) + atol);
   }
   virtual std::string component_name(int i) const { return "y[" + std::to_string(i) + "]"; }
+  // nq > 0 when rows 0..nq-1 are exactly F_i = y'_i - y_{nq+i} (the kinematic rows q' - v): the
+  // integrator then eliminates the velocity corrections from its Newton solves
+  // (core/reduced_linear_solver.h). 0: no such structure.
+  virtual int kinematic_rows() const { return 0; }
 
   // Event functions g(t, y) whose sign changes are located by root finding.
   virtual int num_switches() const { return 0; }

@@ -15,7 +15,7 @@
 
 #include "core/errors.h"
 #include "core/finite_check.h"
-#include "core/klu_linear_solver.h"
+#include "core/reduced_linear_solver.h"
 #include "core/sundials_compat.h"
 
 namespace mbdae {
@@ -232,7 +232,7 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.problem->error_test_mask(data(r.id));
   const CscPattern& pattern = r.problem->jacobian_pattern();
   r.jac = SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx);
-  r.ls = make_klu_linear_solver(pattern, r.ctx);
+  r.ls = make_newton_linear_solver(pattern, r.problem->kinematic_rows(), r.ctx);
   r.mem = IDACreate(r.ctx);
   r.ud.problem = r.problem;
   r.ud.pattern = &pattern;
@@ -484,7 +484,7 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   }
   collect(r.mem, r.stats);
   if (r.stats.ok) r.stats.t_reached = r.t;
-  r.stats.fresh_factorizations = klu_linear_solver_fresh_factorizations(r.ls);
+  r.stats.fresh_factorizations = newton_linear_solver_fresh_factorizations(r.ls);
   std::memcpy(y0.data(), data(r.y), r.n * sizeof(double));
   std::memcpy(yp0.data(), data(r.yp), r.n * sizeof(double));
   r.stats.cpu_seconds = cpu_now() - cpu0;

@@ -1,4 +1,5 @@
-// SUNDIALS IDA on a DaeProblem with a KLU sparse direct solver (core/klu_linear_solver.h).
+// SUNDIALS IDA on a DaeProblem with a KLU sparse direct solver (core/klu_linear_solver.h, or
+// core/reduced_linear_solver.h when the problem declares kinematic rows).
 //
 // Integration runs in one-step mode; output samples are interpolated from IDA's history
 // (IDAGetDky), so sampling never shortens a step. Breakpoints are hit exactly with a stop time;

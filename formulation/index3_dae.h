@@ -26,6 +26,8 @@ class Index3Dae : public MultibodyDae {
   explicit Index3Dae(const System& sys, double constraint_scale = 1.0, bool velocity_error_per_unit_step = true);
 
   int size() const override { return 2 * nq_ + nc_; }
+  // Rows 0..nq-1 are q' - v (assemble_kinematic_and_momentum).
+  int kinematic_rows() const override { return nq_; }
   int residual(double t, const double* y, const double* yp, double* r) override;
   void error_test_mask(double* id) const override;
   // Weights of the error test and the Newton convergence test. Positions: with the velocity

@@ -1,0 +1,186 @@
+// The reduced Newton solve (core/reduced_linear_solver.h) on real Newton matrices of the index-3
+// and index-1 formulations: its solution equals a direct KLU solve of the full matrix, and is
+// as accurate against a long double solution (within 2x of KLU's error, or 1e-12), and
+// problems without kinematic rows (GGL, whose rows q' - v carry the mu columns) get the full
+// solver.
+#include <gtest/gtest.h>
+
+#include <nvector/nvector_serial.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/klu_solver.h"
+#include "core/reduced_linear_solver.h"
+#include "cases/scene.h"
+#include "core/sundials_compat.h"
+#include "formulation/ggl_dae.h"
+#include "formulation/index1_dae.h"
+#include "formulation/index3_dae.h"
+#include "formulation/tests/test_models.h"
+
+namespace mbdae {
+namespace {
+
+// A pendulum (one constraint set, 7 coordinates) and the five-point suspension (49 coordinates,
+// 47 constraint rows, as in its dynamics scenes).
+std::vector<Model> models() {
+  const std::string dir = std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/";
+  return {testing::pendulum(2.0, 0.5, 0.1, 0.3), load_scene(dir + "dynamics_poster.yaml").model};
+}
+
+// A CSC SUNSparseMatrix with the DAE's pattern and its Newton matrix at cj.
+SUNMatrix newton_matrix(DaeProblem& dae, double cj, const std::vector<double>& y,
+                        const std::vector<double>& yp, SUNContext ctx) {
+  const CscPattern& p = dae.jacobian_pattern();
+  SUNMatrix a = SUNSparseMatrix(p.rows, p.cols, p.nnz(), CSC_MAT, ctx);
+  std::copy(p.colptr.begin(), p.colptr.end(), SUNSparseMatrix_IndexPointers(a));
+  std::copy(p.rowind.begin(), p.rowind.end(), SUNSparseMatrix_IndexValues(a));
+  dae.jacobian(0.3, cj, y.data(), yp.data(), SUNSparseMatrix_Data(a));
+  return a;
+}
+
+// max |x - x_ref| / max |x_ref|.
+double relative_difference(const double* x, const double* x_ref, int n) {
+  double diff = 0, size = 0;
+  for (int i = 0; i < n; ++i) {
+    diff = std::max(diff, std::fabs(x[i] - x_ref[i]));
+    size = std::max(size, std::fabs(x_ref[i]));
+  }
+  return diff / size;
+}
+
+// The solution of a x = b by dense LU with full pivoting in long double (64-bit mantissa): an
+// independent reference, 2^11 times finer than double.
+std::vector<double> long_double_solution(const SUNMatrix a, const CscPattern& p, const double* b) {
+  using MatrixL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  using VectorL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+  const int n = p.rows;
+  MatrixL dense = MatrixL::Zero(n, n);
+  const double* values = SUNSparseMatrix_Data(a);
+  VectorL rhs(n);
+  for (int c = 0; c < n; ++c) {
+    for (int k = p.colptr[c]; k < p.colptr[c + 1]; ++k) dense(p.rowind[k], c) += values[k];
+    rhs[c] = b[c];
+  }
+  const VectorL x = dense.fullPivLu().solve(rhs);
+  return std::vector<double>(x.data(), x.data() + n);
+}
+
+// At steps h of 1e-6 to 3e-2 s (cj 37 to 1e6): the reduced solve against KLU on the full
+// matrix, and its error against the long double solution beyond max(1e-12, 2 x KLU's error).
+// At cj = 1 (a 1 s step, about the pendulum's period, far beyond any step IDA takes on these
+// models) the reduced system is dominated by the position derivatives and loses about two
+// digits in the multipliers (1.4e-12 against KLU's 2.4e-14 on the index-1 pendulum): checked
+// to 1e-11 separately.
+struct Differences {
+  double to_full_klu = 0, excess = 0;
+  double to_full_klu_unit_cj = 0;
+};
+
+// The reduced solve against KLU on the full matrix and against the long double solution, at
+// several cj (steps from 1 s to 1e-6 s), for a random state and right side; the worst over cj.
+Differences compare(DaeProblem& dae, const System& sys, unsigned seed) {
+  SUNContext ctx = make_sun_context();
+  const CscPattern& p = dae.jacobian_pattern();
+  const int n = dae.size();
+  SUNLinearSolver ls = make_newton_linear_solver(p, dae.kinematic_rows(), ctx);
+  EXPECT_TRUE(is_reduced_linear_solver(ls));
+  std::vector<double> y, yp;
+  testing::dae_vectors(testing::random_state(sys, seed), n, false, y, yp);
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  N_Vector b = N_VNew_Serial(n, ctx), x = N_VNew_Serial(n, ctx);
+  double* bd = N_VGetArrayPointer(b);
+  double* xd = N_VGetArrayPointer(x);
+  Differences out;
+  for (double cj : {1.0, 37.0, 1e3, 1e5, 1e6}) {
+    SUNMatrix a = newton_matrix(dae, cj, y, yp, ctx);
+    for (int i = 0; i < n; ++i) bd[i] = u(gen);
+    KluSolver full;
+    full.analyze(p);
+    EXPECT_TRUE(full.factor(SUNSparseMatrix_Data(a))) << "cj " << cj;
+    std::vector<double> klu(bd, bd + n);
+    EXPECT_TRUE(full.solve(klu.data()));
+    const std::vector<double> exact = long_double_solution(a, p, bd);
+    EXPECT_EQ(SUNLinSolSetup(ls, a), kLinSolSuccess) << "cj " << cj;
+    EXPECT_EQ(SUNLinSolSolve(ls, a, x, b, 0.0), kLinSolSuccess);
+    if (cj == 1.0) {
+      out.to_full_klu_unit_cj = relative_difference(xd, klu.data(), n);
+    } else {
+      out.to_full_klu = std::max(out.to_full_klu, relative_difference(xd, klu.data(), n));
+      const double bound = std::max(1e-12, 2 * relative_difference(klu.data(), exact.data(), n));
+      out.excess = std::max(out.excess, relative_difference(xd, exact.data(), n) / bound);
+    }
+    // In place (x aliasing b): the same solution.
+    EXPECT_EQ(SUNLinSolSolve(ls, a, b, b, 0.0), kLinSolSuccess);
+    EXPECT_EQ(relative_difference(bd, xd, n), 0.0) << "cj " << cj;
+    SUNMatDestroy(a);
+  }
+  EXPECT_GE(newton_linear_solver_fresh_factorizations(ls), 1);
+  N_VDestroy(b);
+  N_VDestroy(x);
+  SUNLinSolFree(ls);
+  SUNContext_Free(&ctx);
+  return out;
+}
+
+void expect_equal_to_full_klu(DaeProblem& dae, const System& sys, const std::string& name) {
+  const Differences d = compare(dae, sys, 5);
+  EXPECT_LT(d.to_full_klu, 1e-12) << name;
+  EXPECT_LE(d.excess, 1.0) << name;
+  EXPECT_LT(d.to_full_klu_unit_cj, 1e-11) << name;
+  ::testing::Test::RecordProperty("difference_to_full_klu_" + name, testing::sci(d.to_full_klu));
+}
+
+TEST(ReducedSolver, Index3EqualsFullKlu) {
+  for (const Model& m : models()) {
+    const System sys = build_system(m);
+    Index3Dae dae(sys, 7.0);
+    ASSERT_EQ(dae.kinematic_rows(), sys.nq());
+    expect_equal_to_full_klu(dae, sys, m.name);
+  }
+}
+
+TEST(ReducedSolver, Index1EqualsFullKlu) {
+  for (const Model& m : models()) {
+    const System sys = build_system(m);
+    Index1Dae dae(sys, 3.0);
+    ASSERT_EQ(dae.kinematic_rows(), sys.nq());
+    expect_equal_to_full_klu(dae, sys, m.name);
+  }
+}
+
+// GGL's rows q' - v + Phi_q^T mu have more entries: the full solver, by the DAE's declaration
+// and by the pattern check alike.
+TEST(ReducedSolver, GglAndOtherPatternsFallBack) {
+  const System sys = build_system(testing::four_bar(0.4));
+  GglDae ggl(sys);
+  EXPECT_EQ(ggl.kinematic_rows(), 0);
+  EXPECT_FALSE(has_kinematic_rows(ggl.jacobian_pattern(), sys.nq()));
+  SUNContext ctx = make_sun_context();
+  SUNLinearSolver ls = make_newton_linear_solver(ggl.jacobian_pattern(), sys.nq(), ctx);
+  EXPECT_FALSE(is_reduced_linear_solver(ls));
+  EXPECT_EQ(newton_linear_solver_fresh_factorizations(ls), 0);
+  SUNLinSolFree(ls);
+  SUNContext_Free(&ctx);
+
+  Index3Dae dae(sys);
+  const CscPattern& p = dae.jacobian_pattern();
+  EXPECT_TRUE(has_kinematic_rows(p, sys.nq()));
+  EXPECT_FALSE(has_kinematic_rows(p, 0));
+  EXPECT_FALSE(has_kinematic_rows(p, sys.nq() + 1));  // row nq is a momentum row
+  CscPattern missing = p;  // (0, 0) removed: no cj dq_0 in row 0
+  missing.rowind.erase(missing.rowind.begin());
+  for (size_t j = 1; j < missing.colptr.size(); ++j) --missing.colptr[j];
+  EXPECT_FALSE(has_kinematic_rows(missing, sys.nq()));
+}
+
+}  // namespace
+}  // namespace mbdae
