@@ -232,7 +232,7 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.problem->error_test_mask(data(r.id));
   const CscPattern& pattern = r.problem->jacobian_pattern();
   r.jac = SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx);
-  r.ls = make_newton_linear_solver(pattern, r.problem->kinematic_rows(), r.ctx);
+  r.ls = make_newton_linear_solver(pattern, o.reduced_newton ? r.problem->kinematic_rows() : 0, r.ctx);
   r.mem = IDACreate(r.ctx);
   r.ud.problem = r.problem;
   r.ud.pattern = &pattern;

@@ -1,5 +1,6 @@
 // SUNDIALS IDA on a DaeProblem with a KLU sparse direct solver (core/klu_linear_solver.h, or
-// core/reduced_linear_solver.h when the problem declares kinematic rows).
+// core/reduced_linear_solver.h with IdaOptions::reduced_newton when the problem declares
+// kinematic rows).
 //
 // Integration runs in one-step mode; output samples are interpolated from IDA's history
 // (IDAGetDky), so sampling never shortens a step. Breakpoints are hit exactly with a stop time;
@@ -27,6 +28,10 @@ struct IdaOptions {
   double nonlinear_convergence = 0.33;  // IDA's epcon
   double delta_cj = 0.01;               // relative change of cj that forces a new Newton matrix
   const std::atomic<bool>* stop = nullptr;  // set (from a signal handler) to stop after the next step
+  // Newton solves reduced by the problem's kinematic rows (core/reduced_linear_solver.h). Off:
+  // 3-4 % fewer instructions, trajectories equal at the noise floor, but two tests tuned at that
+  // floor move (docs/performance.md, "The reduced Newton solve").
+  bool reduced_newton = false;
 };
 
 struct IdaStats {

@@ -4,7 +4,6 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
-#include <cmath>
 
 #include "core/klu_linear_solver.h"
 #include "core/klu_solver.h"
@@ -72,11 +71,10 @@ KinematicReduction make_kinematic_reduction(const CscPattern& p, int nq) {
   red.target.assign(p.nnz(), -1);
   red.diag.assign(nq, -1);
   red.off.assign(nq, -1);
-  red.q.ptr.push_back(0);
   red.v.ptr.push_back(0);
   for (int j = 0; j < p.cols; ++j) {
     const int c = j < nq ? j : j - nq;  // q column i and v column nq + i go into reduced column i
-    KinematicBlock* block = j < nq ? &red.q : j < 2 * nq ? &red.v : nullptr;
+    const bool v_column = j >= nq && j < 2 * nq;
     for (int k = p.colptr[j]; k < p.colptr[j + 1]; ++k) {
       const int r = p.rowind[k];
       if (r < nq) {
@@ -84,15 +82,15 @@ KinematicReduction make_kinematic_reduction(const CscPattern& p, int nq) {
         continue;
       }
       const int t = reduced_entry(red.pattern, c, r - nq);
-      if (!block) {
+      if (!v_column) {
         red.target[k] = t;
         continue;
       }
-      block->entry.push_back(k);
-      block->row.push_back(r - nq);
-      block->target.push_back(t);
+      red.v.entry.push_back(k);
+      red.v.row.push_back(r - nq);
+      red.v.target.push_back(t);
     }
-    if (block) block->ptr.push_back(static_cast<int>(block->entry.size()));
+    if (v_column) red.v.ptr.push_back(static_cast<int>(red.v.entry.size()));
   }
   return red;
 }
@@ -102,11 +100,10 @@ namespace {
 struct Content {
   KinematicReduction red;
   KluSolver klu;
-  std::vector<double> values;      // reduced matrix
-  std::vector<double> a, b;        // kinematic row i: a_i dq_i + b_i dv_i (cj and -1 for q' - v)
-  std::vector<char> keeps_v;       // per i: reduced unknown i is dv_i (dq_i eliminated), else dq_i
-  std::vector<double> qval, vval;  // values of red.q and red.v
-  std::vector<double> rhs;         // reduced right side, then solution
+  std::vector<double> values;  // reduced matrix
+  std::vector<double> a, b;    // kinematic row i: a_i dq_i + b_i dv_i (cj and -1 for q' - v)
+  std::vector<double> vval;    // values of red.v
+  std::vector<double> rhs;     // reduced right side, then solution
   int last_flag = 0;
 };
 Content* content(SUNLinearSolver s) { return static_cast<Content*>(s->content); }
@@ -115,56 +112,22 @@ SUNLinearSolver_Type get_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; 
 SUNLinearSolver_ID get_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
 int initialize(SUNLinearSolver) { return kLinSolSuccess; }
 
-// Kinematic row i as p u + r e = b1_i: u the kept unknown (reduced column i), e the eliminated one.
-struct RowSplit {
-  const KinematicBlock* kept;
-  const KinematicBlock* eliminated;
-  const double *kept_values, *eliminated_values;
-  double p, r;
-};
-RowSplit split(const Content& c, int i) {
-  if (c.keeps_v[i]) return {&c.red.v, &c.red.q, c.vval.data(), c.qval.data(), c.b[i], c.a[i]};
-  return {&c.red.q, &c.red.v, c.qval.data(), c.vval.data(), c.a[i], c.b[i]};
-}
-
-// Largest |value| of column i of a block.
-double column_max(const KinematicBlock& block, const std::vector<double>& values, int i) {
-  double m = 0;
-  for (int e = block.ptr[i]; e < block.ptr[i + 1]; ++e) m = std::max(m, std::fabs(values[e]));
-  return m;
-}
-
-// Whether dq_i is eliminated (dv_i kept): when the term that elimination adds to the kept column,
-// A_rq b / a, is smaller than that column, A_rv, i.e. |a| max|A_rv| >= |b| max|A_rq| (cj^2 M
-// against the stiffness); else dv_i is eliminated, adding A_rv a / b to A_rq. Either way the
-// reduced column is A_rq + cj A_rv up to a factor; the choice decides which right-side term,
-// A_rv b1 or A_rq b1 / cj, is added, and is the smaller one.
-bool eliminates_q(const Content& c, int i) {
-  return std::fabs(c.a[i]) * column_max(c.red.v, c.vval, i) >=
-         std::fabs(c.b[i]) * column_max(c.red.q, c.qval, i);
-}
-
-// Reduced matrix: column i is A_r,kept - A_r,eliminated p / r (A_rq + cj A_rv when dv_i is
-// eliminated, A_rv + A_rq / cj when dq_i is), the later columns as they are. False if a_i and b_i are
-// both 0.
+// Reduced matrix: column i < nq is A_rq - A_rv a_i / b_i (A_rq + cj A_rv), the later columns as
+// they are. False if some b_i is 0 (dv_i cannot be eliminated).
 bool scatter(Content& c, const double* A) {
   const KinematicReduction& red = c.red;
   std::fill(c.values.begin(), c.values.end(), 0.0);
   for (int k = 0; k < static_cast<int>(red.target.size()); ++k)
     if (red.target[k] >= 0) c.values[red.target[k]] += A[k];
-  for (size_t e = 0; e < red.q.entry.size(); ++e) c.qval[e] = A[red.q.entry[e]];
-  for (size_t e = 0; e < red.v.entry.size(); ++e) c.vval[e] = A[red.v.entry[e]];
   for (int i = 0; i < red.nq; ++i) {
     c.a[i] = A[red.diag[i]];
     c.b[i] = A[red.off[i]];
-    c.keeps_v[i] = eliminates_q(c, i);
-    if ((c.keeps_v[i] ? c.a[i] : c.b[i]) == 0.0) return false;
-    const RowSplit rs = split(c, i);
-    const double s = -rs.p / rs.r;
-    for (int e = rs.kept->ptr[i]; e < rs.kept->ptr[i + 1]; ++e)
-      c.values[rs.kept->target[e]] += rs.kept_values[e];
-    for (int e = rs.eliminated->ptr[i]; e < rs.eliminated->ptr[i + 1]; ++e)
-      c.values[rs.eliminated->target[e]] += s * rs.eliminated_values[e];
+    if (c.b[i] == 0.0) return false;
+    const double s = -c.a[i] / c.b[i];
+    for (int e = red.v.ptr[i]; e < red.v.ptr[i + 1]; ++e) {
+      c.vval[e] = A[red.v.entry[e]];
+      c.values[red.v.target[e]] += s * c.vval[e];
+    }
   }
   return true;
 }
@@ -176,28 +139,26 @@ int setup(SUNLinearSolver s, SUNMatrix a) {
   return ok ? kLinSolSuccess : SUNLS_LUFACT_FAIL;  // recoverable: IDA reduces the step
 }
 
-// x from b: the reduced right side b_r - A_r,eliminated b1 / r, the reduced solve for the kept
-// unknowns, then e_i = (b1_i - p u_i) / r. x may alias b (each b1_i is read before x_i is written).
+// x from b: the reduced right side b_r - A_rv diag(1 / b) b1, the reduced solve for dq and the
+// later unknowns, then dv_i = (b1_i - a_i dq_i) / b_i. x may alias b (each b1_i is read before
+// x_i is written).
 int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector bv, sunrealtype) {
   Content* c = content(s);
+  const KinematicBlock& v = c->red.v;
   const int nq = c->red.nq, n = c->red.n;
   const double* b = N_VGetArrayPointer(bv);
   double* y = N_VGetArrayPointer(x);
   std::copy(b + nq, b + n, c->rhs.begin());
   for (int i = 0; i < nq; ++i) {
-    const RowSplit rs = split(*c, i);
-    const double t = b[i] / rs.r;
-    for (int e = rs.eliminated->ptr[i]; e < rs.eliminated->ptr[i + 1]; ++e)
-      c->rhs[rs.eliminated->row[e]] -= rs.eliminated_values[e] * t;
+    const double t = b[i] / c->b[i];
+    for (int e = v.ptr[i]; e < v.ptr[i + 1]; ++e) c->rhs[v.row[e]] -= c->vval[e] * t;
   }
   const bool ok = c->klu.solve(c->rhs.data());
   c->last_flag = ok ? 0 : 1;
   if (!ok) return kLinSolFailUnrecoverable;
   for (int i = 0; i < nq; ++i) {
-    const RowSplit rs = split(*c, i);
-    const double u = c->rhs[i], e = (b[i] - rs.p * u) / rs.r;
-    y[i] = c->keeps_v[i] ? e : u;
-    y[nq + i] = c->keeps_v[i] ? u : e;
+    y[nq + i] = (b[i] - c->a[i] * c->rhs[i]) / c->b[i];
+    y[i] = c->rhs[i];
   }
   std::copy(c->rhs.begin() + nq, c->rhs.end(), y + 2 * nq);
   return kLinSolSuccess;
@@ -227,8 +188,6 @@ SUNLinearSolver make_reduced(const CscPattern& pattern, int nq, SUNContext ctx) 
   c->values.assign(c->red.pattern.nnz(), 0.0);
   c->a.assign(nq, 0.0);
   c->b.assign(nq, 0.0);
-  c->keeps_v.assign(nq, 0);
-  c->qval.assign(c->red.q.entry.size(), 0.0);
   c->vval.assign(c->red.v.entry.size(), 0.0);
   c->rhs.assign(c->red.pattern.rows, 0.0);
   c->klu.analyze(c->red.pattern);  // symbolic analysis once per pattern

@@ -1,9 +1,9 @@
 // A SUNDIALS linear solver for Newton matrices whose first nq rows are the kinematic rows
-// q'_i - v_i (entries only at (i, i) and (i, nq + i), cj and -1): per row, one of dq_i and dv_i
-// is eliminated with them (dq_i when |cj| >= 1, as partial pivoting would), KluSolver factors the
-// remaining (n - nq) rows, and the eliminated correction is recovered in O(nq). Math: docs/formulation.md, "The reduced
-// Newton solve". Same pivot-reuse policy as make_klu_linear_solver; no allocation after
-// construction.
+// q'_i - v_i (entries only at (i, i) and (i, nq + i): cj and -1): the velocity corrections are
+// eliminated with them (dv = cj dq - b1), KluSolver factors the remaining (n - nq) rows over the
+// q columns and those after the v block, and dv is recovered in O(nq). Math and accuracy:
+// docs/formulation.md, "The reduced Newton solve". Same pivot-reuse policy as
+// make_klu_linear_solver; no allocation after construction.
 #pragma once
 
 #include <sundials/sundials_linearsolver.h>
@@ -14,7 +14,7 @@
 
 namespace mbdae {
 
-// The entries of the q (or v) columns below the kinematic rows, by column i < nq:
+// The entries of the v columns below the kinematic rows, by column i < nq:
 // [ptr[i], ptr[i+1]) index entry (in the full matrix), row and target (in the reduced one).
 struct KinematicBlock {
   std::vector<int> ptr, entry, row, target;
@@ -23,12 +23,11 @@ struct KinematicBlock {
 // The reduced system's pattern and where each entry of the full matrix goes in it.
 struct KinematicReduction {
   int n = 0, nq = 0;           // full size and number of kinematic rows
-  CscPattern pattern;          // (n - nq) x (n - nq): columns i < nq (dq_i or dv_i), then those
-                               // after the v block
-  std::vector<int> target;     // per full entry of a column after the v block: reduced entry
-                               // (-1 for the others)
+  CscPattern pattern;          // (n - nq) x (n - nq): columns q, then those after the v block
+  std::vector<int> target;     // per full entry outside the kinematic rows and the v block:
+                               // reduced entry (-1 for the others)
   std::vector<int> diag, off;  // per kinematic row i: full entries (i, i) and (i, nq + i)
-  KinematicBlock q, v;
+  KinematicBlock v;
 };
 
 // Whether rows 0..nq-1 of the square `pattern` hold exactly the entries (i, i) and (i, nq + i),

@@ -77,8 +77,6 @@ class Index1Dae : public MultibodyDae {
                      BaumgarteParameters baumgarte = {}, bool exact_gamma_q = false, double penalty = 0.0);
 
   int size() const override { return 2 * nq_ + nc_; }
-  // Rows 0..nq-1 are q' - v (assemble_kinematic_and_momentum).
-  int kinematic_rows() const override { return nq_; }
   int residual(double t, const double* y, const double* yp, double* r) override;
   void error_test_mask(double* id) const override;
   // Positions rtol|q| + atol, velocities rtol|v| + atol (atol floored at ten roundings of the

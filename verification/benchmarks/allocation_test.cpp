@@ -51,7 +51,7 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace mbdae {
 namespace {
 
-TEST(Allocations, NoneInTheStepLoop) {
+void expect_none_in_the_step_loop(bool reduced_newton) {
   bench::SuspensionFixture f = bench::suspension_at_equilibrium(
       std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/dynamics_step.yaml");
   Index3Dae dae(f.sys, 1.0);
@@ -65,6 +65,7 @@ TEST(Allocations, NoneInTheStepLoop) {
   o.rtol = 1e-8;
   o.atol = 1e-14;
   o.output_step = 0.001;
+  o.reduced_newton = reduced_newton;
   std::vector<double> q, v, a, sensors(f.sys.sensors.size());
   long at_start = -1, at_end = -1, samples = 0, steps_seen = 0;
   // Windows without events: before the ground step (0.05..0.19 s, at rest) and the settled end
@@ -92,6 +93,10 @@ TEST(Allocations, NoneInTheStepLoop) {
   // The counter works: the setup and the restarts at events allocate.
   EXPECT_GT(g_allocations.load(), 100);
 }
+
+TEST(Allocations, NoneInTheStepLoop) { expect_none_in_the_step_loop(false); }
+// The same with the reduced Newton solve (core/reduced_linear_solver.h).
+TEST(Allocations, NoneInTheReducedNewtonStepLoop) { expect_none_in_the_step_loop(true); }
 
 }  // namespace
 }  // namespace mbdae
