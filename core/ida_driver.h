@@ -28,9 +28,9 @@ struct IdaOptions {
   double nonlinear_convergence = 0.33;  // IDA's epcon
   double delta_cj = 0.01;               // relative change of cj that forces a new Newton matrix
   const std::atomic<bool>* stop = nullptr;  // set (from a signal handler) to stop after the next step
-  // Newton solves reduced by the problem's kinematic rows (core/reduced_linear_solver.h). Off:
-  // 3-4 % fewer instructions, trajectories equal at the noise floor, but two tests tuned at that
-  // floor move (docs/performance.md, "The reduced Newton solve").
+  // Newton solves reduced by the problem's kinematic rows (core/reduced_linear_solver.h); off
+  // until two tests at the noise floor are revisited (docs/performance.md, "The reduced Newton
+  // solve").
   bool reduced_newton = false;
 };
 

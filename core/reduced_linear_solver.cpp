@@ -31,7 +31,7 @@ namespace {
 // Full column of reduced column c: q columns keep their index, later ones skip the v block.
 int full_column(int c, int nq) { return c < nq ? c : c + nq; }
 
-// Sorted rows (shifted by -nq) below the kinematic rows of full column j.
+// The rows (shifted by -nq) of full column j below the kinematic rows.
 void lower_rows(const CscPattern& p, int j, int nq, std::vector<int>& rows) {
   for (int k = p.colptr[j]; k < p.colptr[j + 1]; ++k)
     if (p.rowind[k] >= nq) rows.push_back(p.rowind[k] - nq);
@@ -55,7 +55,7 @@ CscPattern reduced_pattern(const CscPattern& p, int nq) {
   return rp;
 }
 
-// Reduced entry of full entry k (full column j, row r >= nq) in reduced column c.
+// Position of (reduced) row r in reduced column c.
 int reduced_entry(const CscPattern& rp, int c, int r) {
   const auto first = rp.rowind.begin() + rp.colptr[c], last = rp.rowind.begin() + rp.colptr[c + 1];
   return static_cast<int>(std::lower_bound(first, last, r) - rp.rowind.begin());
