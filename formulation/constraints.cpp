@@ -15,42 +15,59 @@ Vec3 world_point(int b, const Vec3& r, const Vec4& p, const Vec3& s) {
 }
 Vec3 world_vector(int b, const Vec4& p, const Vec3& a) { return b < 0 ? a : rotate(p, a); }
 
+// Gradient of (A_i a).(A_j b), the Jacobian row alone (B(p, a)^T w = d(A(p) a . w)/dp).
+Row14 dot1_gradient(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& b) {
+  Row14 g = Row14::Zero();
+  const Vec3 u = world_vector(bi, s.pi, a), w = world_vector(bj, s.pj, b);
+  if (bi >= 0) g.segment<4>(kPi4) = w.transpose() * B_matrix(s.pi, a);
+  if (bj >= 0) g.segment<4>(kPj) = u.transpose() * B_matrix(s.pj, b);
+  return g;
+}
+
 // Value, gradient and Hessian of (A_i a).(A_j b): a dot product of two body-fixed vectors.
 ScalarJet dot1_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& b) {
   ScalarJet j;
   const Vec3 u = world_vector(bi, s.pi, a), w = world_vector(bj, s.pj, b);
   j.value = u.dot(w);
-  Mat34 bu = Mat34::Zero(), bw = Mat34::Zero();
-  if (bi >= 0) {
-    bu = B_matrix(s.pi, a);
-    j.grad.segment<4>(kPi4) = w.transpose() * bu;
-    j.hess.block<4, 4>(kPi4, kPi4) = K_matrix(a, w);
-  }
-  if (bj >= 0) {
-    bw = B_matrix(s.pj, b);
-    j.grad.segment<4>(kPj) = u.transpose() * bw;
-    j.hess.block<4, 4>(kPj, kPj) = K_matrix(b, u);
-  }
+  j.grad = dot1_gradient(bi, bj, s, a, b);
+  if (bi >= 0) j.hess.block<4, 4>(kPi4, kPi4) = K_matrix(a, w);
+  if (bj >= 0) j.hess.block<4, 4>(kPj, kPj) = K_matrix(b, u);
   if (bi >= 0 && bj >= 0) {
+    const Mat34 bu = B_matrix(s.pi, a), bw = B_matrix(s.pj, b);
     j.hess.block<4, 4>(kPi4, kPj) = bu.transpose() * bw;
     j.hess.block<4, 4>(kPj, kPi4) = bw.transpose() * bu;
   }
   return j;
 }
 
-// (A_i a).(P_j - P_i) with P_i = r_i + A_i si, P_j = r_j + A_j sj.
+// Gradient of (A_i a).(P_j - P_i) with P_i = r_i + A_i si, P_j = r_j + A_j sj (the Jacobian row).
+Row14 dot2_gradient(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& si, const Vec3& sj) {
+  Row14 g = Row14::Zero();
+  const Vec3 u = world_vector(bi, s.pi, a);
+  const Vec3 d = world_point(bj, s.rj, s.pj, sj) - world_point(bi, s.ri, s.pi, si);
+  if (bi >= 0) {
+    g.segment<3>(kRi) = -u.transpose();
+    g.segment<4>(kPi4) = d.transpose() * B_matrix(s.pi, a) - u.transpose() * B_matrix(s.pi, si);
+  }
+  if (bj >= 0) {
+    g.segment<3>(kRj) = u.transpose();
+    g.segment<4>(kPj) = u.transpose() * B_matrix(s.pj, sj);
+  }
+  return g;
+}
+
+// Its value, gradient and Hessian.
 ScalarJet dot2_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& si,
                    const Vec3& sj) {
   ScalarJet j;
   const Vec3 u = world_vector(bi, s.pi, a);
   const Vec3 d = world_point(bj, s.rj, s.pj, sj) - world_point(bi, s.ri, s.pi, si);
   j.value = u.dot(d);
-  Mat34 ba = Mat34::Zero(), bs = Mat34::Zero();
+  j.grad = dot2_gradient(bi, bj, s, a, si, sj);
+  Mat34 ba = Mat34::Zero();
   if (bi >= 0) {
     ba = B_matrix(s.pi, a);
-    bs = B_matrix(s.pi, si);
-    j.grad.segment<3>(kRi) = -u.transpose();
-    j.grad.segment<4>(kPi4) = d.transpose() * ba - u.transpose() * bs;
+    const Mat34 bs = B_matrix(s.pi, si);
     j.hess.block<3, 4>(kRi, kPi4) = -ba;
     j.hess.block<4, 3>(kPi4, kRi) = -ba.transpose();
     j.hess.block<4, 4>(kPi4, kPi4) =
@@ -58,8 +75,6 @@ ScalarJet dot2_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec
   }
   if (bj >= 0) {
     const Mat34 bsj = B_matrix(s.pj, sj);
-    j.grad.segment<3>(kRj) = u.transpose();
-    j.grad.segment<4>(kPj) = u.transpose() * bsj;
     j.hess.block<4, 4>(kPj, kPj) = K_matrix(sj, u);
     if (bi >= 0) {
       j.hess.block<4, 3>(kPi4, kRj) = ba.transpose();
@@ -263,7 +278,7 @@ void dot1_value(const Constraint& c, const LocalState& s, double, double* v) {
   v[0] = world_vector(c.bi, s.pi, c.ai).dot(world_vector(c.bj, s.pj, c.aj));
 }
 void dot1_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
-  rows[0] = dot1_jet(c.bi, c.bj, s, c.ai, c.aj).grad;
+  rows[0] = dot1_gradient(c.bi, c.bj, s, c.ai, c.aj);
 }
 void dot1_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
   h += w[0] * dot1_jet(c.bi, c.bj, s, c.ai, c.aj).hess;
@@ -281,7 +296,7 @@ void dot2_value(const Constraint& c, const LocalState& s, double, double* v) {
              .dot(world_point(c.bj, s.rj, s.pj, c.sj) - world_point(c.bi, s.ri, s.pi, c.si));
 }
 void dot2_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
-  rows[0] = dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).grad;
+  rows[0] = dot2_gradient(c.bi, c.bj, s, c.ai, c.si, c.sj);
 }
 void dot2_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
   h += w[0] * dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).hess;

@@ -212,28 +212,31 @@ void assemble_force_derivatives(const System& sys, const std::vector<char>& mode
   }
 }
 
-// Whether local column l of row r of a constraint can be non-zero: orientation-only equations
-// (norm, dot-1, rotation coordinates) do not depend on r; row k of a point constraint depends
-// on r only through r_k. Leaving the structural zeros out of the pattern shrinks the sparse LU.
-static bool structurally_nonzero(const Constraint& c, int r, int l) {
-  const int local = l % 7;
-  if (local >= 3) return c.type != Constraint::Type::kNorm || l < 7;
+// The local columns (bit l, 0..13) that row r of a constraint can make non-zero: orientation-only
+// equations (norm, dot-1, rotation coordinates) do not depend on r; row k of a point constraint
+// depends on r only through r_k; ground's columns are left out. Leaving the structural zeros out
+// of the pattern shrinks the sparse LU; one mask per row keeps the test out of the entry loop.
+static unsigned structural_columns(const Constraint& c, int r) {
+  constexpr unsigned kBoth = 1u | 1u << 7, kRotations = 0x78u * kBoth;  // local 3..6 of each body
+  unsigned translations = 0x7u * kBoth, rotations = kRotations;
   switch (c.type) {
-    case Constraint::Type::kNorm:
+    case Constraint::Type::kNorm: translations = 0, rotations = 0x78u; break;  // its own body only
     case Constraint::Type::kDot1:
-    case Constraint::Type::kOrientation: return false;
-    case Constraint::Type::kCoordinate: return !c.coord.rotation;
+    case Constraint::Type::kOrientation: translations = 0; break;
+    case Constraint::Type::kCoordinate: translations = c.coord.rotation ? 0 : translations; break;
     case Constraint::Type::kPoint: {
-      int comp = -1;
+      int comp = 0;
       for (int k = 0, row = 0; k < 3; ++k)
-        if (c.mask & (1 << k)) {
-          if (row == r) comp = k;
-          ++row;
-        }
-      return local == comp;
+        if ((c.mask & (1 << k)) && row++ == r) comp = k;
+      translations = kBoth << comp;
+      break;
     }
-    default: return true;
+    default: break;
   }
+  unsigned m = translations | rotations;
+  if (c.bi < 0) m &= ~0x7Fu;
+  if (c.bj < 0) m &= ~(0x7Fu << 7);
+  return m;
 }
 
 void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off,
@@ -243,13 +246,14 @@ void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
     constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
-    for (int r = 0; r < c.rows(); ++r)
-      for (int l = 0; l < 14; ++l) {
-        const int g = global_index(c.bi, c.bj, l);
-        if (g < 0 || !structurally_nonzero(c, r, l)) continue;
-        if (row0 >= 0) a.add(row0 + off[k] + r, col0 + g, scale * rows[r](l));
-        if (row0t >= 0) a.add(row0t + g, col0t + off[k] + r, rows[r](l));
+    for (int r = 0; r < c.rows(); ++r) {
+      const int row = off[k] + r;
+      for (unsigned m = structural_columns(c, r); m; m &= m - 1) {
+        const int l = __builtin_ctz(m), g = global_index(c.bi, c.bj, l);
+        if (row0 >= 0) a.add(row0 + row, col0 + g, scale * rows[r](l));
+        if (row0t >= 0) a.add(row0t + g, col0t + row, rows[r](l));
       }
+    }
   }
 }
 

@@ -185,9 +185,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> best_cpus;  // per analysis, for the target rows
   const int reps = quick ? 1 : 3;
   std::vector<Analysis> analyses = {
-      {"kinematics", "kinematics.yaml", 1e-12, 1e-12, {1e-4, 1e-6, 1e-8, 1e-10}},
-      {"dynamics I", "dynamics_step.yaml", 1e-11, 1e-16, {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}},
-      {"dynamics II", "dynamics_poster.yaml", 1e-10, 1e-16, {1e-3, 1e-4, 1e-5, 1e-6, 1e-7}},
+      // From rtol 1e-1 (index3's error per unit step makes even loose tolerances accurate), in
+      // half decades where the 1e-6 m target is met, so that its cost is not a decade's rounding.
+      {"kinematics", "kinematics.yaml", 1e-12, 1e-12, {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-6, 1e-8}},
+      {"dynamics I", "dynamics_step.yaml", 1e-11, 1e-16, {1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 1e-4, 1e-5}},
+      {"dynamics II", "dynamics_poster.yaml", 1e-10, 1e-16, {1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 1e-4}},
   };
   if (quick) analyses.pop_back();
   std::printf("| analysis | rtol | CPU median (s) | max wheel_z error (m) | steps | residual evals | Jacobians | KLU factorizations | samples | W_min (s) | CPU / W_min |\n");

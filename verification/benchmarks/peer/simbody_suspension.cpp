@@ -877,7 +877,10 @@ void run_analysis(Analysis& an, const std::string& scene, const Options& opt,
   if (!mb_default.run.ok) throw std::runtime_error("mbdae failed at its default tolerances: " + mb_default.run.log);
   MbRow mb_matched;
   bool mb_found = false;
-  for (const double rtol : {1e-6, 1e-7, 1e-8}) {
+  // From loose to tight in half decades, up to the loosest rtol that meets the target (index3's
+  // error per unit step meets 1e-6 m from rtol 1e-2 to 3e-3 on the suspension).
+  for (const double rtol : {1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
+    if (mb_found) break;
     char dir[64];
     std::snprintf(dir, sizeof dir, "_rtol%g", rtol);
     MbdaeRun r = run_mbdae(opt.mbdae, scene, opt.work + "/" + an.name + dir, rtol, rtol * 1e-5, opt.repeat);
