@@ -29,8 +29,9 @@ class DaeProblem {
   }
   virtual std::string component_name(int i) const { return "y[" + std::to_string(i) + "]"; }
   // nq > 0 when rows 0..nq-1 are exactly F_i = y'_i - y_{nq+i} (the kinematic rows q' - v): the
-  // integrator then eliminates the velocity corrections from its Newton solves
-  // (core/reduced_linear_solver.h). 0: no such structure.
+  // integrator can eliminate the velocity corrections from its Newton solves
+  // (IdaOptions::reduced_newton, core/reduced_linear_solver.h). 0: no such structure, or not to be
+  // used (index1: docs/formulation.md, "The reduced Newton solve").
   virtual int kinematic_rows() const { return 0; }
 
   // Event functions g(t, y) whose sign changes are located by root finding.

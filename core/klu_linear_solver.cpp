@@ -49,19 +49,23 @@ int free_solver(SUNLinearSolver s) {
 
 }  // namespace
 
-SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx) {
+SUNLinearSolver new_direct_linear_solver(SUNContext ctx, const DirectSolverOps& ops, void* content) {
   SUNLinearSolver s = SUNLinSolNewEmpty(ctx);
   s->ops->gettype = get_type;
   s->ops->getid = get_id;
   s->ops->initialize = initialize;
-  s->ops->setup = setup;
-  s->ops->solve = solve;
-  s->ops->lastflag = last_flag;
-  s->ops->free = free_solver;
+  s->ops->setup = ops.setup;
+  s->ops->solve = ops.solve;
+  s->ops->lastflag = ops.last_flag;
+  s->ops->free = ops.free;
+  s->content = content;
+  return s;
+}
+
+SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx) {
   auto* c = new Content;
   c->klu.analyze(pattern);  // symbolic analysis once per pattern
-  s->content = c;
-  return s;
+  return new_direct_linear_solver(ctx, {setup, solve, last_flag, free_solver}, c);
 }
 
 int klu_linear_solver_fresh_factorizations(SUNLinearSolver s) {

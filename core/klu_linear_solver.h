@@ -13,6 +13,17 @@ namespace mbdae {
 
 class KluSolver;
 
+// The operations that differ between mbdae's direct solvers (this one and
+// core/reduced_linear_solver.h).
+struct DirectSolverOps {
+  int (*setup)(SUNLinearSolver, SUNMatrix);
+  int (*solve)(SUNLinearSolver, SUNMatrix, N_Vector, N_Vector, sunrealtype);
+  sunindextype (*last_flag)(SUNLinearSolver);
+  int (*free)(SUNLinearSolver);
+};
+// A direct SUNLinearSolver (custom id, nothing to initialize) with those operations and content.
+SUNLinearSolver new_direct_linear_solver(SUNContext ctx, const DirectSolverOps& ops, void* content);
+
 // The matrix given to setup must be a CSC SUNSparseMatrix with `pattern`.
 SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx);
 // Factorization counts of a solver made by make_klu_linear_solver.

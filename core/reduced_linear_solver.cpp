@@ -108,10 +108,6 @@ struct Content {
 };
 Content* content(SUNLinearSolver s) { return static_cast<Content*>(s->content); }
 
-SUNLinearSolver_Type get_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
-SUNLinearSolver_ID get_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
-int initialize(SUNLinearSolver) { return kLinSolSuccess; }
-
 // Reduced matrix: column i < nq is A_rq - A_rv a_i / b_i (A_rq + cj A_rv), the later columns as
 // they are. False if some b_i is 0 (dv_i cannot be eliminated).
 bool scatter(Content& c, const double* A) {
@@ -175,14 +171,6 @@ int free_solver(SUNLinearSolver s) {
 }
 
 SUNLinearSolver make_reduced(const CscPattern& pattern, int nq, SUNContext ctx) {
-  SUNLinearSolver s = SUNLinSolNewEmpty(ctx);
-  s->ops->gettype = get_type;
-  s->ops->getid = get_id;
-  s->ops->initialize = initialize;
-  s->ops->setup = setup;
-  s->ops->solve = solve;
-  s->ops->lastflag = last_flag;
-  s->ops->free = free_solver;
   auto* c = new Content;
   c->red = make_kinematic_reduction(pattern, nq);
   c->values.assign(c->red.pattern.nnz(), 0.0);
@@ -191,8 +179,7 @@ SUNLinearSolver make_reduced(const CscPattern& pattern, int nq, SUNContext ctx) 
   c->vval.assign(c->red.v.entry.size(), 0.0);
   c->rhs.assign(c->red.pattern.rows, 0.0);
   c->klu.analyze(c->red.pattern);  // symbolic analysis once per pattern
-  s->content = c;
-  return s;
+  return new_direct_linear_solver(ctx, {setup, solve, last_flag, free_solver}, c);
 }
 
 }  // namespace
