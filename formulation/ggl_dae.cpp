@@ -49,7 +49,6 @@ void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
 
 void GglDae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ || (v_in_test_ && i < 2 * nq_) ? 1.0 : 0.0;
-  mask_slaved_coordinates(id);
 }
 
 void GglDae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {

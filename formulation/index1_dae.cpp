@@ -48,9 +48,6 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
 }
 
 void Index1Dae::error_test_mask(double* id) const {
-  // Coordinates without inertia stay in the test: Baumgarte leaves the position constraints
-  // drifting, so they are not slaved to the inertial ones (measured: 4.5 times the error of the
-  // point-mass-coupler four-bar at the same steps, docs/formulation.md).
   for (int i = 0; i < size(); ++i) id[i] = i < 2 * nq_ ? 1.0 : 0.0;
 }
 

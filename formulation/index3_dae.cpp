@@ -29,7 +29,6 @@ void Index3Dae::assemble(double t, double cj, const double* y, const double* yp)
 
 void Index3Dae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ ? 1.0 : 0.0;
-  if (per_unit_step_) mask_slaved_coordinates(id);  // index3-positions stays the plain test
 }
 
 void Index3Dae::error_weights(double h, const double* y, double rtol, double atol, double* w) const {

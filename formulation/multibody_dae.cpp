@@ -20,23 +20,6 @@ MultibodyDae::MultibodyDae(const System& sys)
   out_phi_.resize(nc_);
 }
 
-void MultibodyDae::mask_slaved_coordinates(double* id) const {
-  if (nq_ <= nc_) return;  // no degree of freedom (kinematics): every coordinate follows the drives
-  std::vector<char> slaved(nq_, 0);
-  bool any_inertial = false;
-  for (int b = 0; b < sys_.num_bodies(); ++b) {
-    const SystemBody& body = sys_.bodies[b];
-    const bool no_inertia = body.inertia.isZero(0.0), no_mass = body.mass == 0.0;
-    for (int k = 0; k < 7; ++k) {
-      slaved[7 * b + k] = no_inertia && (k >= 3 || no_mass);
-      any_inertial = any_inertial || !slaved[7 * b + k];
-    }
-  }
-  if (!any_inertial) return;
-  for (int i = 0; i < nq_; ++i)
-    if (slaved[i]) id[i] = id[nq_ + i] = 0.0;
-}
-
 std::string MultibodyDae::constraint_label(int row) const {
   for (size_t c = 0; c < sys_.constraints.size(); ++c)
     if (row < offsets_[c + 1]) return sys_.constraints[c].label;

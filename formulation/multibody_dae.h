@@ -126,16 +126,6 @@ class MultibodyDae : public DaeProblem {
   static int finite_or_retry(const double* r, int n);
   // Label of the constraint owning stacked constraint row `row`.
   std::string constraint_label(int row) const;
-  // Takes out of the error test (id = 0) the coordinates without inertia, in q and v: the Euler
-  // parameters of a body whose inertia tensor is zero, and all 7 of a body with neither mass nor
-  // inertia. Nothing but the constraints decides them (F2's rows hold no inertia for them), so,
-  // like the multipliers, they are slaved to the inertial coordinates and carry their errors;
-  // tested, they chose most steps of the suspension (docs/formulation.md, "Error control").
-  // Kept in the test when no inertial coordinate would remain, and in a mechanism without
-  // degrees of freedom (a kinematic analysis, nc = nq once redundant equations are removed),
-  // whose coordinates all follow the drives. For formulations whose steps
-  // satisfy the position constraints (index 3, GGL); Baumgarte's drift unties them in index 1.
-  void mask_slaved_coordinates(double* id) const;
   // Rounding noise of the positions through the constraints: about 1e3 eps max(1, |q|).
   double position_noise(const double* y) const;
   // Absolute tolerances never below what rounding lets the Newton iteration resolve (an atol

@@ -78,11 +78,7 @@ Hosts add_composite_bodies(const ModelIndex& index, Poses& poses, System& sys) {
       m += b->mass;
       mc += b->mass * (p.rot * b->com + p.pos);
     }
-    // A lone member's own centre of mass exactly: m x / m can differ from x by a rounding, which
-    // the parallel-axis term below would turn into a spurious inertia of a point mass.
-    const BodySpec* lone = members[h].size() == 1 ? members[h][0] : index.bodies.at(h);
-    const Vec3 com = m > 0 && members[h].size() > 1 ? Vec3(mc / m)
-                                                    : Vec3(in_host[lone->name].rot * lone->com + in_host[lone->name].pos);
+    const Vec3 com = m > 0 ? Vec3(mc / m) : Vec3(in_host[h].rot * index.bodies.at(h)->com + in_host[h].pos);
     Mat3 inertia = Mat3::Zero();
     SystemBody sb;
     sb.name = h;

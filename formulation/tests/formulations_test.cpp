@@ -407,13 +407,12 @@ TEST(Formulations, WheelContactEventsMatchClosedForm) {
   }
 }
 
-// --- e. Coordinates without inertia ----------------------------------------------------------------
+// --- e. A body without inertia ------------------------------------------------------------------
 
-// A four-bar whose coupler is a point mass (no inertia tensor): the loop, not F2, decides the
-// coupler's Euler parameters, so they leave the error test (q for index 3; q and v for index 1),
-// and the crank angle, the mechanism's one degree of freedom, still keeps what rtol promises
-// (index 3 and GGL, whose steps satisfy the position constraints; index 1 keeps them in the test).
-// Ground 2.5 m (not the parallelogram of testing::four_bar, whose change points are singular):
+// A four-bar whose coupler is a point mass (no inertia tensor): only the loop decides the
+// coupler's Euler parameters. Index 3 keeps what rtol promises on its crank angle, the
+// mechanism's one degree of freedom. (Taking such slaved coordinates out of the error test was
+// measured and not kept: docs/formulation.md, "Error control".) Ground 2.5 m (not the parallelogram of testing::four_bar, whose change points are singular):
 // no link turns fully, the rocker swings through no singular configuration.
 Model point_mass_coupler_four_bar() {
   Model m = testing::four_bar(0.4);
@@ -433,48 +432,7 @@ System assembled(const Model& m) {
   return sys;
 }
 
-int body_index(const System& sys, const std::string& name) {
-  for (int b = 0; b < sys.num_bodies(); ++b)
-    if (sys.bodies[b].name == name) return b;
-  return -1;
-}
-
-TEST(Formulations, CoordinatesWithoutInertiaLeaveTheErrorTest) {
-  const System sys = assembled(point_mass_coupler_four_bar());
-  const int nq = sys.nq(), coupler = body_index(sys, "coupler"), crank = body_index(sys, "crank");
-  ASSERT_GE(coupler, 0);
-  ASSERT_GE(crank, 0);
-  Index3Dae i3(sys, 1.0, true);
-  Index1Dae i1(sys);
-  std::vector<double> id3(i3.size()), id1(i1.size());
-  i3.error_test_mask(id3.data());
-  i1.error_test_mask(id1.data());
-  for (int k = 0; k < 7; ++k) {
-    const bool tested = k < 3;  // the point mass's position stays in the test
-    EXPECT_EQ(id3[7 * coupler + k], tested ? 1.0 : 0.0) << k;
-    EXPECT_EQ(id1[7 * coupler + k], 1.0) << k;
-    EXPECT_EQ(id1[nq + 7 * coupler + k], 1.0) << k;
-    EXPECT_EQ(id3[7 * crank + k], 1.0) << k;
-    EXPECT_EQ(id1[nq + 7 * crank + k], 1.0) << k;
-    EXPECT_EQ(id3[nq + 7 * crank + k], 0.0) << k;  // index 3: v out of the test as before
-  }
-  // A body with neither mass nor inertia: all 7; none at all inertial: nothing is taken out.
-  Model m = point_mass_coupler_four_bar();
-  m.bodies[1].mass = 0;
-  const System massless = assembled(m);
-  Index3Dae m3(massless, 1.0, true);
-  std::vector<double> idm(m3.size());
-  m3.error_test_mask(idm.data());
-  for (int k = 0; k < 7; ++k) EXPECT_EQ(idm[7 * coupler + k], 0.0) << k;
-  for (auto& b : m.bodies) b.mass = 0, b.inertia.setZero();
-  const System none = assembled(m);
-  Index3Dae n3(none, 1.0, true);
-  std::vector<double> idn(n3.size());
-  n3.error_test_mask(idn.data());
-  for (int i = 0; i < none.nq(); ++i) EXPECT_EQ(idn[i], 1.0) << i;
-}
-
-TEST(Formulations, CoordinatesWithoutInertiaKeepThePromise) {
+TEST(Formulations, PointMassCouplerKeepsThePromise) {
   const System sys = assembled(point_mass_coupler_four_bar());
   IdaOptions o;
   o.t1 = 3.0;
@@ -498,7 +456,7 @@ TEST(Formulations, CoordinatesWithoutInertiaKeepThePromise) {
   for (double x : ref.x) scale = std::max(scale, std::fabs(x));
   EXPECT_LT(max_diff(chk.x, ref.x), 1e-8 * scale);
   // Index 3 keeps the promise; GGL, which misses it on every case (docs/work-precision.md), is
-  // printed (measured: 117 rtol with these coordinates out of the test, 266 rtol with them in).
+  // printed (measured: 266 rtol).
   const double rtol = 1e-6;
   const RunResult r3 = run("index3", rtol, i3), rg = run("index2-ggl", rtol, ggl);
   for (const auto* r : {&r3, &rg}) {
