@@ -43,6 +43,7 @@ IdaOptions integration_options(const RunOptions& opt, const AnalysisStep& step, 
   io.max_step = step.max_step;
   io.stop = opt.stop;
   io.nonlinear_convergence = step.newton_convergence;
+  io.reduced_newton = step.newton_solve == "reduced";
   js["newton_convergence"] = io.nonlinear_convergence;
   js["rtol"] = io.rtol;
   js["output_projection"] = step.output_projection;
@@ -239,6 +240,8 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
   const IdaOptions io = integration_options(c.options, step, tol, js);
   const std::unique_ptr<MultibodyDae> dae = make_dae(sys, *f, step, tol, js);
+  // The solve used: the reduced one only where the formulation has the kinematic rows.
+  js["newton_solve"] = io.reduced_newton && dae->kinematic_rows() > 0 ? "reduced" : "full";
   std::vector<double> y, yp;
   if (!start(c, step, *dae, y, yp, js)) return false;
   const RunInfo info{&c.scene, &sys, &step, &c.result.columns, &c.result.units};

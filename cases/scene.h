@@ -25,6 +25,9 @@ struct AnalysisStep {
   bool error_estimate = false;  // repeat the run at rtol / 100 to estimate its error (cases/error_estimate.h)
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
+  // "reduced": Newton solves with the velocity corrections eliminated through q' - v (index3
+  // only; core/reduced_linear_solver.h); "full": KLU on the whole Newton matrix.
+  std::string newton_solve = "full";
   bool output_projection = false;    // project output samples onto the constraints
   std::string formulation = "index3";  // index3, index3-positions, index2-ggl, index1 or penalty
   // index1, penalty: stabilization [1/s]; negative: 5 / the model's fast time scale.

@@ -860,6 +860,9 @@ struct Loader {
     s.newton_convergence = opt_number(n, "newton_convergence").value_or(s.newton_convergence);
     if (!(s.newton_convergence > 0 && s.newton_convergence <= 1))
       error(at(n, "newton_convergence"), "newton_convergence", "out of range (0, 1], got " + format_number(s.newton_convergence));
+    s.newton_solve = text(n, "newton_solve", s.newton_solve);
+    if (has(n, "newton_solve") && n["newton_solve"].IsScalar() && s.newton_solve != "full" && s.newton_solve != "reduced")
+      error(n["newton_solve"], "newton_solve", "expected full or reduced, got " + quote(s.newton_solve));
     s.baumgarte_alpha = opt_number(n, "baumgarte_alpha").value_or(s.baumgarte_alpha);
     s.baumgarte_beta = opt_number(n, "baumgarte_beta").value_or(s.baumgarte_beta);
     if (has(n, "baumgarte_alpha") && !(s.baumgarte_alpha >= 0)) error(at(n, "baumgarte_alpha"), "baumgarte_alpha", "must not be negative, got " + format_number(s.baumgarte_alpha));

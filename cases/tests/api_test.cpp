@@ -3,6 +3,7 @@
 // like the file's own errors.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <fstream>
@@ -134,8 +135,8 @@ void expect_same_scene(const Scene& a, const Scene& b) {
   for (size_t k = 0; k < a.steps.size(); ++k) {
     const AnalysisStep &x = a.steps[k], &y = b.steps[k];
     EXPECT_EQ(x.type, y.type);
-    EXPECT_EQ(std::tie(x.hold, x.release, x.unknowns, x.quiet_sensors, x.formulation, x.mode_check),
-              std::tie(y.hold, y.release, y.unknowns, y.quiet_sensors, y.formulation, y.mode_check));
+    EXPECT_EQ(std::tie(x.hold, x.release, x.unknowns, x.quiet_sensors, x.formulation, x.mode_check, x.newton_solve),
+              std::tie(y.hold, y.release, y.unknowns, y.quiet_sensors, y.formulation, y.mode_check, y.newton_solve));
     EXPECT_EQ(std::tie(x.t0, x.t_end, x.output_step, x.rtol, x.atol, x.max_step, x.constraint_scale),
               std::tie(y.t0, y.t_end, y.output_step, y.rtol, y.atol, y.max_step, y.constraint_scale)) << k;
     EXPECT_EQ(std::tie(x.newton_convergence, x.output_projection, x.baumgarte_alpha, x.baumgarte_beta, x.penalty),
@@ -183,6 +184,31 @@ TEST(SetParameter, AnalysisStepByTypeAndByIndex) {
   ASSERT_EQ(edited.steps[2].rtol, 1.0e-7);
   expect_same_scene(s, edited);
   expect_same_run(s, edited);
+}
+
+// newton_solve: reduced (core/reduced_linear_solver.h) runs Dynamics I to the same trajectory as
+// the full Newton solve, up to the rounding the different linear solves leave (measured 3e-10 m
+// at the scene's rtol 1e-8: docs/performance.md); summary.json names the solve used, and a
+// formulation without the kinematic rows (index2-ggl) keeps the full one.
+TEST(SetParameter, ReducedNewtonSolveGivesTheSameTrajectory) {
+  const Scene full = load_scene(kDir + "dynamics_step.yaml");
+  const Scene reduced = with_parameters(full, {{"analysis.dynamics.newton_solve", "reduced"}});
+  const Result rf = run(full, RunOptions()), rr = run(reduced, RunOptions());
+  ASSERT_TRUE(rf.ok()) << rf.message;
+  ASSERT_TRUE(rr.ok()) << rr.message;
+  EXPECT_EQ(rf.summary["steps"][2]["newton_solve"], "full");
+  EXPECT_EQ(rr.summary["steps"][2]["newton_solve"], "reduced");
+  const std::vector<double>&zf = rf.column("wheel_z"), &zr = rr.column("wheel_z");
+  ASSERT_EQ(zf.size(), zr.size());
+  double worst = 0;
+  for (size_t i = 0; i < zf.size(); ++i) worst = std::max(worst, std::fabs(zf[i] - zr[i]));
+  RecordProperty("max_wheel_z_difference", std::to_string(worst));
+  EXPECT_LT(worst, 1e-8);  // both runs are within about 1e-9 m of the converged reference
+  RunOptions ggl;
+  ggl.formulation = "index2-ggl";
+  const Result rg = run(with_parameters(reduced, {{"analysis.dynamics.t_end", "0.1"}}), ggl);
+  ASSERT_TRUE(rg.ok()) << rg.message;
+  EXPECT_EQ(rg.summary["steps"][2]["newton_solve"], "full");
 }
 
 TEST(SetParameter, ModelFileValueEqualsEditedModelFile) {

@@ -317,6 +317,13 @@ TEST(SceneValidation, PenaltyFormulation) {
   expect_one(t, line_of(t, "penalty: 0"), "penalty", "must be positive");
 }
 
+TEST(SceneValidation, NewtonSolve) {
+  const std::string ok = with("atol: 1.0e-8}", "atol: 1.0e-8, newton_solve: reduced}");
+  EXPECT_TRUE(errors_of(ok).empty()) << joined(errors_of(ok));
+  const std::string t = with("atol: 1.0e-8}", "atol: 1.0e-8, newton_solve: sparse}");
+  expect_one(t, line_of(t, "newton_solve"), "newton_solve", "expected full or reduced, got 'sparse'");
+}
+
 TEST(SceneValidation, TooManyOutputRows) {
   const std::string t = with("output_step: 0.01", "output_step: 1.0e-12");
   expect_one(t, line_of(t, "output_step:"), "output_step", "more than 1e8 output rows");
