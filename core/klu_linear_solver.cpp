@@ -37,16 +37,6 @@ int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   return ok ? kLinSolSuccess : kLinSolFailUnrecoverable;
 }
 
-sunindextype last_flag(SUNLinearSolver s) { return content(s)->last_flag; }
-
-int free_solver(SUNLinearSolver s) {
-  if (!s) return kLinSolSuccess;
-  delete content(s);
-  s->content = nullptr;
-  SUNLinSolFreeEmpty(s);
-  return kLinSolSuccess;
-}
-
 }  // namespace
 
 SUNLinearSolver new_direct_linear_solver(SUNContext ctx, const DirectSolverOps& ops, void* content) {
@@ -65,7 +55,7 @@ SUNLinearSolver new_direct_linear_solver(SUNContext ctx, const DirectSolverOps& 
 SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx) {
   auto* c = new Content;
   c->klu.analyze(pattern);  // symbolic analysis once per pattern
-  return new_direct_linear_solver(ctx, {setup, solve, last_flag, free_solver}, c);
+  return new_direct_linear_solver(ctx, setup, solve, c);
 }
 
 int klu_linear_solver_fresh_factorizations(SUNLinearSolver s) {

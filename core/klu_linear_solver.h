@@ -8,6 +8,7 @@
 #include <sundials/sundials_linearsolver.h>
 
 #include "core/sparse_assembler.h"
+#include "core/sundials_compat.h"
 
 namespace mbdae {
 
@@ -23,6 +24,21 @@ struct DirectSolverOps {
 };
 // A direct SUNLinearSolver (custom id, nothing to initialize) with those operations and content.
 SUNLinearSolver new_direct_linear_solver(SUNContext ctx, const DirectSolverOps& ops, void* content);
+// The same for a content C made with new and holding the last flag in `last_flag`: lastflag reads
+// it, free deletes the content.
+template <class C>
+SUNLinearSolver new_direct_linear_solver(SUNContext ctx, decltype(DirectSolverOps::setup) setup,
+                                         decltype(DirectSolverOps::solve) solve, C* content) {
+  const auto last_flag = [](SUNLinearSolver s) -> sunindextype { return static_cast<C*>(s->content)->last_flag; };
+  const auto free_solver = [](SUNLinearSolver s) -> int {
+    if (!s) return kLinSolSuccess;
+    delete static_cast<C*>(s->content);
+    s->content = nullptr;
+    SUNLinSolFreeEmpty(s);
+    return kLinSolSuccess;
+  };
+  return new_direct_linear_solver(ctx, {setup, solve, last_flag, free_solver}, content);
+}
 
 // The matrix given to setup must be a CSC SUNSparseMatrix with `pattern`.
 SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx);

@@ -160,16 +160,6 @@ int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector bv, sunrealtype) {
   return kLinSolSuccess;
 }
 
-sunindextype last_flag(SUNLinearSolver s) { return content(s)->last_flag; }
-
-int free_solver(SUNLinearSolver s) {
-  if (!s) return kLinSolSuccess;
-  delete content(s);
-  s->content = nullptr;
-  SUNLinSolFreeEmpty(s);
-  return kLinSolSuccess;
-}
-
 SUNLinearSolver make_reduced(const CscPattern& pattern, int nq, SUNContext ctx) {
   auto* c = new Content;
   c->red = make_kinematic_reduction(pattern, nq);
@@ -179,7 +169,7 @@ SUNLinearSolver make_reduced(const CscPattern& pattern, int nq, SUNContext ctx) 
   c->vval.assign(c->red.v.entry.size(), 0.0);
   c->rhs.assign(c->red.pattern.rows, 0.0);
   c->klu.analyze(c->red.pattern);  // symbolic analysis once per pattern
-  return new_direct_linear_solver(ctx, {setup, solve, last_flag, free_solver}, c);
+  return new_direct_linear_solver(ctx, setup, solve, c);
 }
 
 }  // namespace
