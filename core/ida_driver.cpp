@@ -297,10 +297,7 @@ void ida_failure(IdaRun& r, int flag) {
   const std::string worst = worst_components(r.mem, *r.problem, r.ys, r.yps, r.id);
   if (!worst.empty()) os << "; largest error estimates: " << worst;
   if (!r.ud.last_ida_error.empty()) os << "; IDA: " << r.ud.last_ida_error;
-  r.stats.ok = false;
-  r.stats.status = "integration_failed";
-  r.stats.message = os.str();
-  r.stats.t_reached = r.t;
+  fail(r, "integration_failed", os.str(), r.t);  // reached: the last accepted step
 }
 
 double sample_time(const IdaRun& r, long k) {
