@@ -1,6 +1,7 @@
 #include "core/output.h"
 
 #include "core/errors.h"
+#include "core/output_guard.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -59,6 +60,20 @@ int open_for_writing(const std::string& path) {
   return ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
 }
 
+// A new file (a new inode) in place of any old one: the repair process of an earlier, killed run
+// may still hold the old one (core/output_guard.h) and must not cut this run's rows. Locked
+// (flock) while it is written.
+int open_new_file(const std::string& path) {
+  if (::unlink(path.c_str()) != 0 && errno != ENOENT) return -1;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd >= 0 && ::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    // A file system without locks: readers cannot wait for a repair, nothing else changes.
+  }
+  return fd;
+}
+
+constexpr size_t kPageBytes = 4096;  // a write within one page is never cut by SIGKILL
+
 }  // namespace
 
 std::string csv_field(const std::string& name) {
@@ -77,6 +92,7 @@ CsvWriter::~CsvWriter() {
     if (!failed_) close();
   } catch (const std::exception&) {
   }
+  end_output_guard(guard_);
   if (fd_ >= 0) ::close(fd_);
 }
 
@@ -90,11 +106,15 @@ void CsvWriter::open(const std::string& path, const std::vector<std::string>& co
   bytes_on_disk_ = 0;
   failed_ = false;
   const std::string partial = path + ".partial";
-  fd_ = open_for_writing(partial);
+  fd_ = open_new_file(partial);
   if (fd_ < 0) throw OutputError("cannot write " + partial + ": " + os_error(errno));
   std::string header;
   for (size_t k = 0; k < columns.size(); ++k) header += (k ? "," : "") + csv_field(columns[k]);
   header += '\n';
+  if (header.size() > kPageBytes) {
+    guard_ = start_output_guard(fd_);
+    announce_write(guard_, 0, static_cast<long long>(header.size()));
+  }
   const int err = write_all(fd_, header.data(), header.size(), 0);
   if (err) {
     failed_ = true;
@@ -124,9 +144,13 @@ void CsvWriter::row(const double* v) {
   ++rows_;
 }
 
-// One write of whole rows; on a failure the file is cut back to its last whole row.
+// One write of whole rows; on a failure the file is cut back to its last whole row. The repair
+// process starts at the first write that can be cut (most runs end before it: no process).
 void CsvWriter::write_buffer() {
   if (used_ == 0) return;
+  if (guard_.pid < 0 && used_ > kPageBytes - static_cast<size_t>(bytes_on_disk_ % kPageBytes))
+    guard_ = start_output_guard(fd_);
+  announce_write(guard_, bytes_on_disk_, bytes_on_disk_ + static_cast<long long>(used_));
   const int err = write_all(fd_, buffer_.data(), used_, bytes_on_disk_);
   if (err) {
     failed_ = true;
@@ -149,6 +173,7 @@ void CsvWriter::close() {
   if (fd_ < 0) return;
   if (failed_) throw OutputError("cannot write " + path_ + ".partial: an earlier write failed");
   write_buffer();
+  end_output_guard(guard_);
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) {

@@ -1,8 +1,9 @@
 // Result files written safely. Rows go to NAME.partial through a buffer that holds whole rows
-// only, so every write(2) ends at a row end and even a killed run leaves whole rows. Every
-// write, close and rename is checked: a failure throws OutputError naming the file and the OS
-// error, the .partial file is cut back to its last whole row and keeps its .partial name. Only a
-// file written completely is renamed to NAME (docs/errors.md, exit code 4).
+// only, so every write(2) ends at a row end; a repair process cuts back a write that SIGKILL
+// stopped halfway (core/output_guard.h), so even a killed run leaves whole rows. Every write,
+// close and rename is checked: a failure throws OutputError naming the file and the OS error,
+// the .partial file is cut back to its last whole row and keeps its .partial name. Only a file
+// written completely is renamed to NAME (docs/errors.md, exit code 4).
 #pragma once
 
 #include <stdexcept>
@@ -10,6 +11,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "core/output_guard.h"
 
 namespace mbdae {
 
@@ -37,6 +40,7 @@ class CsvWriter {
  private:
   void write_buffer();
   int fd_ = -1;
+  OutputGuard guard_;  // cuts the file back to whole rows if this process is killed
   bool failed_ = false;
   std::string path_;
   size_t columns_ = 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -246,7 +247,9 @@ TEST_F(OutputFaults, SigtermAndSigintDuringRun) {
   }
 }
 
-// SIGKILL at several moments: only whole rows on disk, no summary claiming anything.
+// SIGKILL at several moments, right after the file grew (so often inside a write that the kernel
+// stops at a page boundary): after the repair process is done (a reader's flock waits for it,
+// core/output_guard.h), only whole rows on disk, no summary claiming anything.
 TEST_F(OutputFaults, SigkillLeavesWholeRows) {
   for (int k = 0; k < 5; ++k) {
     fs::remove_all(out);
@@ -256,6 +259,10 @@ TEST_F(OutputFaults, SigkillLeavesWholeRows) {
     int sig = 0;
     wait_exit(pid, &sig);
     EXPECT_EQ(sig, SIGKILL);
+    const int reader = ::open((out / "results.csv.partial").c_str(), O_RDONLY | O_CLOEXEC);
+    ASSERT_GE(reader, 0);
+    EXPECT_EQ(::flock(reader, LOCK_SH), 0);
+    ::close(reader);
     EXPECT_GT(check_whole_rows(out / "results.csv.partial"), 100);
     EXPECT_FALSE(fs::exists(out / "results.csv"));
     EXPECT_FALSE(fs::exists(out / "summary.json"));
