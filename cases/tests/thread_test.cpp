@@ -1,12 +1,20 @@
 // No global mutable state: the suspension's Dynamics I (equilibrium, then the ground step with
 // tyre lift-off and re-contact) run in 4 threads at once gives each thread the single-threaded
 // Result bit for bit. Two threads share one Scene, two load their own. Also built with
-// ThreadSanitizer (-DMBDAE_TSAN=ON, .ci/run).
+// ThreadSanitizer (-DMBDAE_TSAN=ON, .ci/run). The same with results.csv written by each thread,
+// each file with its own repair process (core/output_guard.h, whose list of ended processes is
+// the one state shared between runs).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "cases/mbdae.h"
+#include "cases/sinks.h"
 
 namespace mbdae {
 namespace {
@@ -58,6 +66,40 @@ TEST(Threads, FourDynamicsRunsAtOnceEqualTheSingleThreadedRun) {
     EXPECT_TRUE(r.q == reference.q) << "thread " << k;
     EXPECT_EQ(without_cpu(r.summary), without_cpu(reference.summary)) << "thread " << k;
   }
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Threads, FourCsvFilesAtOnceEqualTheSingleThreadedFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("mbdae_threads_csv_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Scene scene = load_scene(kScene);
+  {
+    CsvSink csv((dir / "reference.csv").string());
+    ASSERT_TRUE(run(scene, quiet(), {&csv}).ok());
+  }
+  const std::string reference = read_text(dir / "reference.csv");
+  ASSERT_GT(reference.size(), 50000u);  // page-crossing writes: each run starts its repair process
+  std::vector<std::thread> threads;
+  std::vector<int> ok(4, 0);
+  for (int k = 0; k < 4; ++k)
+    threads.emplace_back([&, k] {
+      CsvSink csv((dir / ("thread" + std::to_string(k) + ".csv")).string());
+      ok[k] = run(scene, quiet(), {&csv}).ok();
+    });
+  for (auto& t : threads) t.join();
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_TRUE(ok[k]) << "thread " << k;
+    EXPECT_TRUE(read_text(dir / ("thread" + std::to_string(k) + ".csv")) == reference) << "thread " << k;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
