@@ -22,6 +22,7 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   rhs_.resize(n);
   work_.resize(n);
   work2_.resize(n);
+  scratch_.resize(3 * static_cast<size_t>(n));
   for (auto& h : history_) h.resize(n);
 }
 
@@ -94,27 +95,82 @@ bool AugmentedSolver::output_accelerations(const std::vector<char>& modes, const
 }
 
 void AugmentedSolver::remember_output(double t) {
-  std::rotate(std::begin(history_), std::begin(history_) + 2, std::end(history_));
-  std::copy_backward(std::begin(history_t_), std::begin(history_t_) + 2, std::end(history_t_));
-  history_[0].assign(rhs_.begin(), rhs_.end());  // same size: no allocation
+  choose_extrapolation_order(t);
+  std::rotate(std::begin(history_), std::begin(history_) + kHistory - 1, std::end(history_));
+  std::copy_backward(std::begin(history_t_), std::begin(history_t_) + kHistory - 1, std::end(history_t_));
+  history_[0].assign(rhs_.begin(), rhs_.end());  // same size after the first kHistory samples
   history_t_[0] = t;
-  history_size_ = std::min(history_size_ + 1, 3);
+  history_size_ = std::min(history_size_ + 1, kHistory);
 }
 
-// Lagrange extrapolation to t through the remembered samples (constant, linear or quadratic).
-void AugmentedSolver::predict_accelerations(double t, double* x) const {
-  const int m = history_size_;
-  double w[3] = {1, 0, 0};
-  for (int i = 0; i < m; ++i) {
-    w[i] = 1;
-    for (int j = 0; j < m; ++j)
-      if (j != i) w[i] *= (t - history_t_[j]) / (history_t_[i] - history_t_[j]);
+// Lagrange weights at t for the newest `points` samples (degree points - 1).
+void AugmentedSolver::extrapolation_weights(double t, int points, double* w) const {
+  for (int i = 0; i < points; ++i) {
+    double num = 1, den = 1;
+    for (int j = 0; j < points; ++j)
+      if (j != i) {
+        num *= t - history_t_[j];
+        den *= history_t_[i] - history_t_[j];
+      }
+    w[i] = num / den;
   }
+}
+
+void AugmentedSolver::predict_accelerations(double t, int points, double* x) const {
+  double w[kHistory];
+  extrapolation_weights(t, points, w);
   const int n = nq_ + nc_;
   for (int k = 0; k < n; ++k) {
     double s = 0;
-    for (int i = 0; i < m; ++i) s += w[i] * history_[i][k];
+    for (int i = 0; i < points; ++i) s += w[i] * history_[i][k];
     x[k] = s;
+  }
+}
+
+// The order is chosen like a BDF code's: of the extrapolations through points_ - 1, points_ and
+// points_ + 1 samples, the one that would have predicted this sample's solution (in rhs_) best,
+// its error in a and in lambda each relative to the block's max norm. Smooth motion sampled
+// finely raises the degree (fewer refinement corrections); a kink or coarse sampling lowers it.
+void AugmentedSolver::choose_extrapolation_order(double t) {
+  if (history_size_ < 2 || ++samples_since_choice_ < kChoiceInterval) return;
+  samples_since_choice_ = 0;
+  const int lo = std::max(1, points_ - 1), hi = std::min(points_ + 1, history_size_);
+  double w[3][kHistory] = {};
+  for (int m = lo; m <= hi; ++m) extrapolation_weights(t, m, w[m - lo]);
+  const int n = nq_ + nc_;
+  double* s[3] = {scratch_.data(), scratch_.data() + n, scratch_.data() + 2 * n};
+  std::fill(scratch_.begin(), scratch_.end(), 0.0);
+  for (int i = 0; i < hi; ++i) {
+    const double* h = history_[i].data();
+    for (int c = 0; c < 3; ++c) {
+      const double wc = w[c][i];
+      double* sc = s[c];
+      for (int k = 0; k < n; ++k) sc[k] += wc * h[k];
+    }
+  }
+  // Plain comparisons rather than std::fmax (a libm call per entry): the values are finite here.
+  auto max_abs_diff = [](const double* x, const double* y, int k0, int k1) {
+    double m = 0;
+    for (int k = k0; k < k1; ++k) {
+      const double d = std::fabs(x[k] - (y ? y[k] : 0.0));
+      m = d > m ? d : m;
+    }
+    return m;
+  };
+  double e[3][2] = {}, xmax[2] = {0, 0};
+  for (int b = 0; b < 2; ++b) {
+    const int k0 = b ? nq_ : 0, k1 = b ? n : nq_;
+    xmax[b] = max_abs_diff(rhs_.data(), nullptr, k0, k1);
+    for (int c = 0; c < 3; ++c) e[c][b] = max_abs_diff(s[c], rhs_.data(), k0, k1);
+  }
+  double best = INFINITY;
+  for (int m = lo; m <= hi; ++m) {
+    const double* em = e[m - lo];
+    const double error = (xmax[0] > 0 ? em[0] / xmax[0] : 0) + (xmax[1] > 0 ? em[1] / xmax[1] : 0);
+    if (error < best) {
+      best = error;
+      points_ = m;
+    }
   }
 }
 
@@ -127,7 +183,7 @@ bool AugmentedSolver::refine_accelerations(double t, double tolerance) {
   const CscPattern& p = asm_.pattern();
   const int n = nq_ + nc_;
   double* x = work2_.data();
-  predict_accelerations(t, x);
+  predict_accelerations(t, std::min(points_, history_size_), x);
   double last_dx[2] = {0, 0};
   for (int it = 0; it < kMaxRefinements; ++it) {
     std::copy(rhs_.begin(), rhs_.end(), work_.begin());

@@ -32,9 +32,9 @@ class AugmentedSolver {
   // The accelerations of an output sample, without a factorization where one of a nearby state
   // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration
   // matrix K0 (a KluSolver of its own, so that output samples do not change the factorizations
-  // the integration's own solves see), from x extrapolated through the last output samples
-  // (quadratic in t), accepted when the estimated error of a and of lambda is below `tolerance`
-  // times their max norms; else the direct solve of accelerations(). Samples come in increasing
+  // the integration's own solves see), from x extrapolated through the last output samples (a
+  // polynomial in t, its degree chosen from the samples: choose_extrapolation_order), accepted
+  // when the estimated error of a and of lambda is below `tolerance` times their max norms; else the direct solve of accelerations(). Samples come in increasing
   // t; a call of accelerations() (a restart, possibly over a discontinuity) starts the
   // extrapolation afresh. docs/performance.md has the measurements.
   bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,
@@ -46,6 +46,7 @@ class AugmentedSolver {
   struct RefinementStats {  // how output samples were solved (tests, benchmarks)
     long refined = 0, direct = 0, corrections = 0;
   } refinement;
+  int extrapolation_points() const { return points_; }  // samples the next extrapolation uses
   bool velocities(const double* q, double t, double* v);
   PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100,
                                 double regularization = 0.0);
@@ -61,7 +62,9 @@ class AugmentedSolver {
                            const double* v, double t);
   void assemble_acceleration_system(const std::vector<char>& modes, const double* q,
                                     const double* v, double t);
-  void predict_accelerations(double t, double* x) const;
+  void extrapolation_weights(double t, int points, double* w) const;
+  void predict_accelerations(double t, int points, double* x) const;
+  void choose_extrapolation_order(double t);
   bool refine_accelerations(double t, double tolerance);
   void remember_output(double t);
   void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
@@ -73,10 +76,16 @@ class AugmentedSolver {
   std::vector<double> values_, rhs_, work_, work2_, trial_;
   KluSolver klu_output_;  // output samples' acceleration matrix K0
   bool output_prepared_ = false;
-  // The last output solutions [a; lambda] and their times (history_[0] the newest).
+  // The last output solutions [a; lambda] and their times (history_[0] the newest), and how many
+  // of them the next extrapolation goes through.
+  static constexpr int kHistory = 8;
   int history_size_ = 0;
-  double history_t_[3] = {0, 0, 0};
-  std::vector<double> history_[3];
+  int points_ = 3;
+  static constexpr int kChoiceInterval = 4;  // samples between two choices of points_
+  int samples_since_choice_ = 0;
+  double history_t_[kHistory] = {};
+  std::vector<double> history_[kHistory];
+  std::vector<double> scratch_;  // the three candidate extrapolations
 };
 
 }  // namespace mbdae

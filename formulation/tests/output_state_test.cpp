@@ -52,8 +52,8 @@ TEST(OutputState, NonFiniteStateIsReported) {
 
 // Output accelerations by refinement on an earlier factorization (AugmentedSolver::
 // output_accelerations) against the direct solve at the same state, along a moving four-bar
-// (positions and velocities projected onto the constraints every 1 ms, 0.4 s).
-TEST(OutputState, RefinedAccelerationsMatchTheDirectSolve) {
+// (positions and velocities projected onto the constraints every `h`, 400 samples).
+AugmentedSolver::RefinementStats refined_against_direct(double h, double speed, int* points) {
   System sys = build_system(testing::four_bar(0.7));
   std::vector<double> q = sys.q0, v(sys.nq()), a(sys.nq()), a_ref(sys.nq());
   AugmentedSolver(sys).positions(q.data(), 0.0, 1e-13, 50);
@@ -61,23 +61,23 @@ TEST(OutputState, RefinedAccelerationsMatchTheDirectSolve) {
   AugmentedSolver sampler(sys), direct(sys);
   sampler.prepare_output_accelerations();
   const std::vector<char> modes(sys.forces.size(), 0);
-  for (int i = 0; i < sys.nq(); ++i) v[i] = 2.0 * std::sin(1.0 + i);
-  ASSERT_TRUE(direct.velocities(q.data(), 0.0, v.data()));
-  const double h = 1e-3, tolerance = 1e-10;
+  for (int i = 0; i < sys.nq(); ++i) v[i] = speed * std::sin(1.0 + i);
+  EXPECT_TRUE(direct.velocities(q.data(), 0.0, v.data()));
+  const double tolerance = 1e-10;
   double worst = 0;
   for (int k = 0; k <= 400; ++k) {
     const double t = k * h;
-    if (k > 0) {
-      ASSERT_TRUE(direct.accelerations(modes, q.data(), v.data(), t, a_ref.data(), nullptr));
+    if (k > 0) {  // a symplectic Euler step, then back onto the constraints
+      EXPECT_TRUE(direct.accelerations(modes, q.data(), v.data(), t, a_ref.data(), nullptr));
       for (int i = 0; i < sys.nq(); ++i) {
-        q[i] += h * v[i];
         v[i] += h * a_ref[i];
+        q[i] += h * v[i];
       }
-      ASSERT_TRUE(direct.positions(q.data(), t, 1e-13, 50).converged);
-      ASSERT_TRUE(direct.velocities(q.data(), t, v.data()));
+      EXPECT_TRUE(direct.positions(q.data(), t, 1e-13, 50).converged);
+      EXPECT_TRUE(direct.velocities(q.data(), t, v.data()));
     }
-    ASSERT_TRUE(sampler.output_accelerations(modes, q.data(), v.data(), t, a.data(), tolerance));
-    ASSERT_TRUE(direct.accelerations(modes, q.data(), v.data(), t, a_ref.data(), nullptr));
+    EXPECT_TRUE(sampler.output_accelerations(modes, q.data(), v.data(), t, a.data(), tolerance));
+    EXPECT_TRUE(direct.accelerations(modes, q.data(), v.data(), t, a_ref.data(), nullptr));
     double err = 0, norm = 0;
     for (int i = 0; i < sys.nq(); ++i) {
       err = std::fmax(err, std::fabs(a[i] - a_ref[i]));
@@ -86,11 +86,31 @@ TEST(OutputState, RefinedAccelerationsMatchTheDirectSolve) {
     worst = std::fmax(worst, err / norm);
   }
   EXPECT_LT(worst, 10 * tolerance);
-  // Most samples were refined, a few factored.
-  EXPECT_GT(sampler.refinement.refined, 300) << "direct " << sampler.refinement.direct;
-  EXPECT_GT(sampler.refinement.direct, 0);
-  std::printf("refined %ld, direct %ld, corrections %ld, worst relative error %.2e\n", sampler.refinement.refined,
-              sampler.refinement.direct, sampler.refinement.corrections, worst);
+  std::printf("h %g: refined %ld, direct %ld, corrections %ld, extrapolation through %d samples, worst relative error %.2e\n",
+              h, sampler.refinement.refined, sampler.refinement.direct, sampler.refinement.corrections,
+              sampler.extrapolation_points(), worst);
+  *points = sampler.extrapolation_points();
+  return sampler.refinement;
+}
+
+// Fine samples of a smooth motion: most samples refined (a few factored: the first, and where K
+// drifted from K0), two corrections each (the least the error estimate needs), the
+// extrapolation's degree above the quadratic.
+TEST(OutputState, RefinedAccelerationsMatchTheDirectSolve) {
+  int points = 0;
+  const auto r = refined_against_direct(1e-3, 2.0, &points);
+  EXPECT_GT(r.refined, 300) << "direct " << r.direct;
+  EXPECT_GT(r.direct, 0);
+  EXPECT_LT(r.corrections, 2.2 * r.refined);
+  EXPECT_GT(points, 3);
+}
+
+// Coarse samples of a fast motion (20 ms apart, velocities 15 times those above): the
+// extrapolation falls to a low degree and most samples are factored afresh; the same accuracy.
+TEST(OutputState, CoarseSamplesLowerTheExtrapolationDegree) {
+  int points = 0;
+  refined_against_direct(2e-2, 30.0, &points);
+  EXPECT_LE(points, 2);
 }
 
 }  // namespace
