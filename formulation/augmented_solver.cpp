@@ -98,7 +98,7 @@ void AugmentedSolver::remember_output(double t) {
   choose_extrapolation_order(t);
   std::rotate(std::begin(history_), std::begin(history_) + kHistory - 1, std::end(history_));
   std::copy_backward(std::begin(history_t_), std::begin(history_t_) + kHistory - 1, std::end(history_t_));
-  history_[0].assign(rhs_.begin(), rhs_.end());  // same size after the first kHistory samples
+  history_[0].assign(rhs_.begin(), rhs_.end());  // same size: no allocation
   history_t_[0] = t;
   history_size_ = std::min(history_size_ + 1, kHistory);
 }
