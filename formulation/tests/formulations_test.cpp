@@ -24,14 +24,17 @@
 #include "formulation/redundancy.h"
 #include "formulation/system.h"
 #include "formulation/tolerance_scales.h"
+#include "formulation/tests/integrate_model.h"
 #include "formulation/tests/test_models.h"
-#include "formulation/tests/pendulum_reference.h"
 
 namespace mbdae {
 namespace {
 
 using mbdae::testing::downward_crossings;
 using mbdae::testing::elliptic_k;
+using mbdae::testing::integrate_model;
+using mbdae::testing::measured_period;
+using mbdae::testing::RunResult;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -183,47 +186,12 @@ struct Recording : Dae {
   }
 };
 
-struct RunResult {
-  IdaStats stats;
-  std::vector<double> t, x, rate;  // coordinate 0 and its rate at the samples
-  double max_position_violation = 0, max_norm_drift = 0;
-};
-
-// Integrates `dae` from the model's initial configuration at rest; samples coordinate 0 and its
-// rate from the projected output, as run() does.
-template <class Dae>
-RunResult integrate_model(Dae& dae, const IdaOptions& o) {
-  const System& sys = dae.system();
-  RunResult run;
-  std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
-  std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
-  dae.modes = initial_modes(sys, y.data(), o.t0);
-  dae.consistent_initial_values(o.t0, y, yp);
-  std::vector<double> q, v, a;
-  run.stats = integrate(dae, o, y, yp, [&](double t, const double* yy, const double* yyp) {
-    dae.consistent_output(t, yy, yyp, q, v, a, true);
-    run.t.push_back(t);
-    run.x.push_back(coordinate_value(sys, 0, q.data()));
-    run.rate.push_back(coordinate_rate(sys, 0, q.data(), v.data()));
-    return true;
-  });
-  run.max_position_violation = dae.max_position_violation;
-  run.max_norm_drift = dae.max_norm_drift;
-  return run;
-}
-
 // Pendulum: m = 2 kg, centre of mass d = 0.5 m below the pivot, I_xx = 0.05 kg m^2 about the
 // centre of mass, released at rest from 1 rad about the x axis.
 constexpr double kMass = 2.0, kD = 0.5, kIxx = 0.05, kTheta0 = 1.0, kG = 9.81;
 double exact_period() {
   const double i_pivot = kIxx + kMass * kD * kD;
   return 4.0 * std::sqrt(i_pivot / (kMass * kG * kD)) * elliptic_k(std::sin(kTheta0 / 2));
-}
-
-double measured_period(const RunResult& r) {
-  const std::vector<double> c = downward_crossings(r.t, r.x, r.rate);
-  if (c.size() < 2) return 0;
-  return (c.back() - c.front()) / static_cast<double>(c.size() - 1);
 }
 
 double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
