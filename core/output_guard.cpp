@@ -36,15 +36,15 @@ constexpr const char* kRepairScript =
 
 // A line of a few bytes: one send, all or nothing. MSG_NOSIGNAL: a repair process that is gone
 // (killed on its own) gives EPIPE, not a SIGPIPE that would end the writer.
-bool write_line(int fd, const char* text, size_t n) {
+// A failed send leaves the file unguarded from then on; the run goes on.
+void write_line(int fd, const char* text, size_t n) {
   while (n > 0) {
     const ssize_t w = ::send(fd, text, n, MSG_NOSIGNAL);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return false;
+    if (w <= 0) return;
     text += w;
     n -= static_cast<size_t>(w);
   }
-  return true;
 }
 
 // Repair processes told "done" but not yet exited. Waiting for each would add its exit (about
