@@ -1,11 +1,11 @@
-// Parameter overrides on the parsed YAML trees (cases/scene_overrides.h).
-#include "cases/scene_overrides.h"
+// Parameter overrides on the parsed YAML trees (cases/scene/scene_overrides.h).
+#include "cases/scene/scene_overrides.h"
 
 #include <algorithm>
 #include <cctype>
 #include <vector>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "core/errors.h"
 
 namespace mbdae {
