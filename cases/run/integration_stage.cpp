@@ -236,6 +236,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");
   js["formulation"] = name;
+  js["integrator"] = f->integrator_name;
   const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
   const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
   const IdaOptions io = integration_options(c.options, step, tol, js);
@@ -254,7 +255,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   }
   Sampler sampler(c, step, *dae, io.output_step);
   const size_t rows_before = c.result.rows();
-  const IdaStats st = integrate(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
+  const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
   std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
