@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <set>
 #include <vector>
 
@@ -182,18 +183,31 @@ void collect_paths(const YAML::Node& n, const std::string& prefix, bool steps, s
     }
   } else if (n.IsSequence()) {
     bool has_maps = false;
+    for (size_t k = 0; k < n.size(); ++k) has_maps = has_maps || n[k].IsMap();
+    if (!has_maps && !prefix.empty()) out.push_back(prefix);  // the whole list, then its elements
     for (size_t k = 0; k < n.size(); ++k) {
       std::string seg = std::to_string(k);
-      if (n[k].IsMap()) {
-        has_maps = true;
-        const char* key = steps ? "type" : "name";
-        if (n[k][key] && n[k][key].IsScalar() && item_index(n, n[k][key].Scalar(), steps) == static_cast<long>(k))
-          seg = n[k][key].Scalar();
-      }
+      const char* key = steps ? "type" : "name";
+      if (n[k].IsMap() && n[k][key] && n[k][key].IsScalar() &&
+          item_index(n, n[k][key].Scalar(), steps) == static_cast<long>(k))
+        seg = n[k][key].Scalar();
       collect_paths(n[k], dot + seg, false, out);
     }
-    if (!has_maps && !prefix.empty()) out.push_back(prefix);
   }
+}
+
+// True for a number, or a list of numbers (lists of lists included): the values that have units.
+bool numeric(const YAML::Node& n) {
+  if (n.IsScalar()) {
+    const std::string& s = n.Scalar();
+    char* end = nullptr;
+    std::strtod(s.c_str(), &end);
+    return !s.empty() && end && *end == '\0';
+  }
+  if (!n.IsSequence() || n.size() == 0) return false;
+  for (const auto& e : n)
+    if (!numeric(e)) return false;
+  return true;
 }
 
 // 'R' or 'T' for a coordinate named `name` (its joint's chain element), '?' if not found.
@@ -230,6 +244,7 @@ std::vector<ParameterEntry> list_parameters(YAML::Node scene, const std::string&
     }
     const YAML::Node value = child(r.parent, segs.back(), r.last_is_step);
     if (!value.IsDefined() || value.IsMap() || value.IsNull()) continue;
+    if (segs.size() == 3 && segs[2] == "name") continue;  // an item's name is its path segment
     // The item a field belongs to (forces.tyre for forces.tyre.stiffness) gives the type.
     const YAML::Node root = r.in_scene ? scene : *model;
     const YAML::Node item = segs.size() > 2 ? walk(root, segs, 2) : YAML::Node();
@@ -241,8 +256,8 @@ std::vector<ParameterEntry> list_parameters(YAML::Node scene, const std::string&
       kind = coordinate_kind(scene, item["coordinate"].Scalar());
       if (kind == '?' && model) kind = coordinate_kind(*model, item["coordinate"].Scalar());
     }
-    out.push_back({path, yaml_text(value), parameter_unit(segs, type, kind), r.in_scene ? scene_file : model_file,
-                   line_of(value)});
+    out.push_back({path, yaml_text(value), numeric(value) ? parameter_unit(segs, type, kind) : "",
+                   r.in_scene ? scene_file : model_file, line_of(value)});
   }
   return out;
 }

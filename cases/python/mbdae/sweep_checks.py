@@ -22,7 +22,7 @@ def plain(v):
 
 def suggestion(name, candidates):
     """" (did you mean 'x'?)" for the closest candidate, or ""."""
-    close = difflib.get_close_matches(name, list(candidates), n=3, cutoff=0.6)
+    close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
     if not close:
         return ""
     return " (did you mean " + " or ".join(f"'{c}'" for c in close) + "?)"

@@ -112,3 +112,14 @@ def test_cpu_seconds_is_the_solving_threads_own():
         # Process CPU would be >= 2 x alone (two runs, the spinning thread besides); a run's own
         # thread clock stays near `alone` (cache sharing and frequency changes: within 1.6 x).
         assert 0.5 * alone < r.cpu_seconds() < 1.6 * alone, (r.cpu_seconds(), alone)
+
+
+def test_imported_from_the_install_under_test():
+    """Under .ci/run's pip-install step (MBDAE_INSTALLED_IN: the virtual environment) the
+    package comes from that environment, not from the build tree or the checkout."""
+    import os
+    where = os.environ.get("MBDAE_INSTALLED_IN")
+    if not where:
+        pytest.skip("testing the build tree (PYTHONPATH)")
+    assert Path(mbdae.__file__).resolve().is_relative_to(Path(where).resolve()), mbdae.__file__
+    assert Path(_core.__file__).with_name("_core.pyi").exists() and Path(mbdae.__file__).with_name("py.typed").exists()
