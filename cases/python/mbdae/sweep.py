@@ -226,15 +226,18 @@ def _sweep_locked(scene, runs, out, client, metrics, options, workers, progress,
     defs = {n: metric_fingerprint(f) for n, f in metrics.items()}
     try:
         manifest = _manifest(out, scene, runs, keys, options, defs, extend)
-        rows = {}
-        for e in manifest["runs"]:
-            row = finished_row(out, e["key"])
+        rows, broken = {}, 0
+        for i, e in enumerate(manifest["runs"]):
+            row, problem = finished_row(out, e["key"])
             if row is not None:
                 rows[e["key"]] = _refresh_metrics(out, row, metrics, defs)
+            elif problem:
+                broken += 1
+                print(f"mbdae sweep: run {i}: {problem}; it runs again", file=sys.stderr)
     except OSError as e:
         raise SweepOutputError(e.errno, f"{out}: cannot write the sweep's files: {e.strerror or e}; nothing "
                                f"was run") from None
-    params = {e["key"]: e["params"] for e in manifest["runs"]}
+    params = {e["key"]: e["params"] for e in manifest["runs"]}  # (a key listed twice runs once)
     todo = [k for k in dict.fromkeys(e["key"] for e in manifest["runs"]) if k not in rows]
     skipped = len(params) - len(todo)
     bar = _Bar(len(params), skipped, progress)
@@ -251,6 +254,7 @@ def _sweep_locked(scene, runs, out, client, metrics, options, workers, progress,
         raise SweepOutputError(e.errno, f"{out}/runs.csv: cannot be written: {e.strerror or e}; every run is "
                                f"finished and kept in {out}/runs (start the sweep again to write the table)") from None
     table.attrs["skipped"] = skipped
+    table.attrs["rerun_broken"] = broken
     return table
 
 

@@ -135,24 +135,31 @@ def record(out, index, key, run, payload, metric_defs):
 
 
 def finished_row(out, key):
-    """The row of a finished run whose files are whole (the .json parses and names this key, the
-    .h5 is there with the SHA-256 the row recorded), else None (the run is run again). A broken
-    run's files are removed."""
+    """(row, problem) of a run: the row of a finished run whose files are whole (the .json parses
+    and names this key, the .h5 is there with the SHA-256 the row recorded) and "", or None and
+    what is wrong ("" if the run never finished). A broken run's files are removed (it runs again)."""
     jpath = out / "runs" / f"{key}.json"
     if not jpath.exists():
-        return None
+        return None, ""
     row = read_json(jpath)
-    ok = isinstance(row, dict) and row.get("key") == key and row.get("status") not in RETRY_STATUSES
-    if ok and row.get("file"):
+    problem = ""
+    if not isinstance(row, dict) or row.get("key") != key:
+        problem = "its row is truncated or not JSON"
+    elif row.get("status") in RETRY_STATUSES:
+        problem = ""  # lost last time: simply run again
+    elif row.get("file"):
         h5 = out / row["file"]
-        ok = h5.is_file() and sha256_file(h5) == row.get("file_sha256")
-    elif ok:
-        ok = not row.get("rows")  # a run with samples must have its file
-    if not ok:
-        for p in (jpath, out / "runs" / f"{key}.h5"):
-            try:
-                p.unlink()
-            except FileNotFoundError:
-                pass
-        return None
-    return row
+        if not h5.is_file():
+            problem = f"{row['file']} is missing"
+        elif sha256_file(h5) != row.get("file_sha256"):
+            problem = f"{row['file']} does not match its recorded SHA-256 (truncated or changed)"
+    elif row.get("rows"):
+        problem = "its samples file is missing"
+    if isinstance(row, dict) and not problem and row.get("status") not in RETRY_STATUSES:
+        return row, ""
+    for p in (jpath, out / "runs" / f"{key}.h5"):
+        try:
+            p.unlink()
+        except FileNotFoundError:
+            pass
+    return None, problem

@@ -134,7 +134,7 @@ def test_one_sweep_per_folder_and_other_runs_only_with_extend(tmp_path):
     assert p.returncode == 1 and "--extend" in p.stderr, p.stderr
 
 
-def test_resume_verifies_each_runs_files_and_reruns_broken_ones(tmp_path):
+def test_resume_verifies_each_runs_files_and_reruns_broken_ones(tmp_path, capsys):
     scene = short_scene()
     first = mbdae.sweep(scene, GRID, out=tmp_path, metrics={"travel": M.peak_deviation("wheel_z")}, progress=False)
     runs = tmp_path / "runs"
@@ -146,7 +146,10 @@ def test_resume_verifies_each_runs_files_and_reruns_broken_ones(tmp_path):
     data[len(data) // 2] ^= 0xFF                                   # a flipped byte
     (runs / f"{keys[2]}.h5").write_bytes(bytes(data))
     again = mbdae.sweep(scene, GRID, out=tmp_path, metrics={"travel": M.peak_deviation("wheel_z")}, progress=False)
-    assert again.attrs["skipped"] == 0 and (again["status"] == "ok").all()
+    assert again.attrs["skipped"] == 0 and again.attrs["rerun_broken"] == 3 and (again["status"] == "ok").all()
+    err = capsys.readouterr().err
+    assert f"run 0: runs/{keys[0]}.h5 is missing; it runs again" in err
+    assert "run 1: its row is truncated or not JSON" in err and "run 2: " in err and "SHA-256" in err
     assert list(again["travel"]) == list(first["travel"])
     for i in range(3):
         samples, _, _ = mbdae.read_run(tmp_path, i)
