@@ -110,7 +110,7 @@ def test_sweep_killed_half_way_resumes_without_redoing_runs(tmp_path):
         time.sleep(0.02)
     os.killpg(p.pid, signal.SIGKILL)  # the sweep and its local worker process
     p.wait()
-    finished = {f: f.stat().st_mtime_ns for f in runs.glob("run_*.*") if f.suffix in (".json", ".h5")}
+    finished = {f: f.stat().st_mtime_ns for f in runs.glob("*.*") if f.suffix in (".json", ".h5")}
     n_done = len([f for f in finished if f.suffix == ".json"])
     assert 6 <= n_done < 30, n_done
     p = _shell_sweep(tmp_path)
