@@ -1,7 +1,7 @@
 // mbdae's public C++ API: load a scene, override its parameters by path, run its analyses and
 // get the results in memory. Writers (CSV, summary JSON, animation, ...) are sinks that see the
 // output samples as they come and the Result at the end. The command-line program
-// (cases/main.cpp) and the Python package (cases/python/) are thin users of this header.
+// (cases/cli/main.cpp) and the Python package (cases/python/) are thin users of this header.
 //
 //   mbdae::Scene scene = mbdae::load_scene("cases/five_point_suspension/dynamics_step.yaml");
 //   mbdae::set_parameter(scene, "forces.tyre.stiffness", "3.0e5");
@@ -21,14 +21,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/scene.h"  // Scene, AnalysisStep, SceneError, load_scene, load_scene_text
+#include "cases/scene/scene.h"  // Scene, AnalysisStep, SceneError, load_scene, load_scene_text
 
 namespace mbdae {
 
 struct System;  // formulation/system.h: the mechanism in absolute coordinates
 
 // ---- Scenes ---------------------------------------------------------------------------------
-// load_scene(path) and load_scene_text(text, path) are declared in cases/scene.h.
+// load_scene(path) and load_scene_text(text, path) are declared in cases/scene/scene.h.
 
 // Overrides one scene parameter by its path and reloads the scene with the scene file's own
 // validation (a bad value throws SceneError naming the file, the line of the overridden item
@@ -105,7 +105,7 @@ struct Sample {
   double input_time = 0;  // time at which inputs (ground, drives) were evaluated
 };
 
-// An output writer (cases/sinks.h: CsvSink, SummarySink). begin() and sample() may throw (std::runtime_error with the file named):
+// An output writer (cases/output/sinks.h: CsvSink, SummarySink). begin() and sample() may throw (std::runtime_error with the file named):
 // the run then stops with status "output_failed" and end() is still called.
 class Sink {
  public:

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 from matplotlib import animation as mpl_animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
-# Cell "part" codes (cases/animation_sink.h, legend.json).
+# Cell "part" codes (cases/output/animation_sink.h, legend.json).
 AXIS, BODY_LINE, BODY_POINT, JOINT, CUT, FORCE_LINE, FORCE_VECTOR, SHAPE, GROUND = range(9)
 
 

@@ -55,7 +55,7 @@ for lib in mbdae_core mbdae_formulation mbdae_scene; do
   for f in $(library_sources "$lib"); do sources+=("$root/$f"); done
 done
 if [[ ${#sources[@]} -lt 3 ]]; then
-  sources=("$root"/core/*.cpp "$root"/formulation/*.cpp "$root/cases/scene_loader.cpp" "$root/cases/scene_validation.cpp")
+  sources=("$root"/core/*.cpp "$root"/formulation/*.cpp "$root/cases/scene/scene_loader.cpp" "$root/cases/scene/scene_validation.cpp")
 fi
 sources+=("$here/scene_loader_fuzz.cpp")
 

@@ -7,7 +7,7 @@
 // build_system rejects also counts as a finding: validate_scene should have reported it.
 //
 // An input whose first line is `#!mbdae ARGS` (a YAML comment, so the scene still reads) also
-// runs the command-line parser (cases/cli_options.h) on `run scene.yaml ARGS` (split at spaces)
+// runs the command-line parser (cases/cli/cli_options.h) on `run scene.yaml ARGS` (split at spaces)
 // and checks the overrides against the scene: a refusal must say why, nothing may crash.
 //
 // Built and run by cases/fuzz/run_fuzz.sh. The scene's path is cases/fuzz/scene.yaml, so that
@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "cases/analysis_types.h"
-#include "cases/cli_options.h"
-#include "cases/scene.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/cli/cli_options.h"
+#include "cases/scene/scene.h"
 #include "core/errors.h"
 #include "formulation/system.h"
 

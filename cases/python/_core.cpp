@@ -13,10 +13,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "cases/analysis_types.h"
-#include "cases/animation_sink.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/output/animation_sink.h"
 #include "cases/mbdae.h"
-#include "cases/sinks.h"
+#include "cases/output/sinks.h"
 #include "core/output.h"
 #include "core/errors.h"
 
@@ -25,8 +25,8 @@ namespace py = pybind11;
 namespace {
 
 // The API's RunOptions plus the folder that run(out=) writes results.csv and summary.json to
-// (through the CLI's sinks, cases/sinks.h) and the folder of run(animation=) (an AnimationSink,
-// cases/animation_sink.h).
+// (through the CLI's sinks, cases/output/sinks.h) and the folder of run(animation=) (an AnimationSink,
+// cases/output/animation_sink.h).
 struct PyRunOptions : mbdae::RunOptions {
   std::string out_dir, animation_dir;
   double animation_rate = 0;  // frames per second of simulated time (0: the scene's)

@@ -15,7 +15,7 @@
 #include <sstream>
 #include <string>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "cases/tests/run_command.h"
 #include "formulation/system.h"
 

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "cases/analysis_types.h"
-#include "cases/scene.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/scene/scene.h"
 #include "cases/tests/run_command.h"
 #include "core/errors.h"
 #include "formulation/system.h"
@@ -173,7 +173,7 @@ TEST(SceneValidation, FieldDoesNotApplyToType) {
   expect_one(t, line_of(t, "radius: 0.3"), "radius", "does not apply to a spring_damper force");
 }
 
-// The analysis types come from one table (cases/analysis_types.h): their names in the message for
+// The analysis types come from one table (cases/scene/analysis_types.h): their names in the message for
 // an unknown one, their own fields in the message for a field of another type.
 TEST(SceneValidation, AnalysisTypesFromTheRegistry) {
   std::string t = with("{type: assembly}", "{type: linearization}");

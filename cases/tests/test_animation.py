@@ -1,4 +1,4 @@
-"""End-to-end checks of the animation output (cases/animation_sink.h, cases/animation/video.py).
+"""End-to-end checks of the animation output (cases/output/animation_sink.h, cases/animation/video.py).
 
 The .vtp frames are read back with VTK's own XML reader and compared with the run's position
 and force_length sensors at the same times, to 1e-12 m. Run by ctest:

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "cases/mbdae.h"
-#include "cases/sinks.h"
+#include "cases/output/sinks.h"
 
 namespace mbdae {
 namespace {

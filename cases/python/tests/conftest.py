@@ -28,7 +28,7 @@ def _overrides_implemented():
 
 OVERRIDES = _overrides_implemented()
 # Tests of parameter overrides: expected to fail with "not implemented" until set_parameter lands
-# (cases/api.cpp); they run normally from then on.
+# (cases/run/api.cpp); they run normally from then on.
 needs_overrides = pytest.mark.xfail(not OVERRIDES, raises=RuntimeError, strict=True,
                                     reason="mbdae::set_parameter not implemented yet in this build")
 

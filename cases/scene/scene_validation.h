@@ -12,7 +12,7 @@
 #include <tuple>
 #include <vector>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 
 namespace mbdae {
 

@@ -1,4 +1,4 @@
-#include "cases/field_ranges.h"
+#include "cases/scene/field_ranges.h"
 
 #include <sstream>
 

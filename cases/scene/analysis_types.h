@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 
 namespace mbdae {
 
@@ -21,7 +21,7 @@ struct AnalysisType {
   AnalysisStep::Type type;
   bool integrates = false;         // a time span with output samples (t0, t_end, output_step, ...)
   std::vector<std::string> fields;  // the step fields that apply to it ("type" included)
-  // The stage of run() (cases/run_stages.h): false when the step failed (recorded in the context).
+  // The stage of run() (cases/run/run_stages.h): false when the step failed (recorded in the context).
   bool (*stage)(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js) = nullptr;
 };
 

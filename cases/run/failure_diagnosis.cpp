@@ -1,4 +1,4 @@
-#include "cases/failure_diagnosis.h"
+#include "cases/run/failure_diagnosis.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
-// Range checks shared by the scene loader (cases/scene_loader.cpp) and the command-line
-// overrides (cases/cli_options.cpp), so that a value refused in a scene is refused with the same
+// Range checks shared by the scene loader (cases/scene/scene_loader.cpp) and the command-line
+// overrides (cases/cli/cli_options.cpp), so that a value refused in a scene is refused with the same
 // message on the command line. Each returns the message for a value out of range, "" if it is fine.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The public API's scene functions (cases/mbdae.h); run() is in cases/run.cpp.
+// The public API's scene functions (cases/mbdae.h); run() is in cases/run/run.cpp.
 #include "cases/mbdae.h"
 
 namespace mbdae {

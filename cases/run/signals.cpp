@@ -1,4 +1,4 @@
-#include "cases/signals.h"
+#include "cases/run/signals.h"
 
 #include <csignal>
 

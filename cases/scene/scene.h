@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "cases/animation_spec.h"
+#include "cases/output/animation_spec.h"
 #include "formulation/model.h"
 
 namespace mbdae {
@@ -22,7 +22,7 @@ struct AnalysisStep {
   // (formulation/tolerance_scales.h).
   double rtol = 1e-6, atol = 0, max_step = 0;
   double length_scale = 0, time_scale = 0, atol_rotation = 0, atol_velocity = 0;
-  bool error_estimate = false;  // repeat the run at rtol / 100 to estimate its error (cases/error_estimate.h)
+  bool error_estimate = false;  // repeat the run at rtol / 100 to estimate its error (cases/run/error_estimate.h)
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
   // "reduced": Newton solves with the velocity corrections eliminated through q' - v (index3
@@ -46,7 +46,7 @@ struct AnalysisStep {
   SourceLocation where;
 };
 
-struct SceneSource;  // cases/scene_source.h: the texts it was read from, and its overrides
+struct SceneSource;  // cases/scene/scene_source.h: the texts it was read from, and its overrides
 
 // One parameter of a scene as `mbdae params` lists it (cases/scene_overrides.h): the path
 // set_parameter takes, its value as YAML text, its SI unit ("" if none or not known) and the
@@ -62,7 +62,7 @@ struct Scene {
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
   std::string redundant_constraints = "remove";  // or "fail"
-  AnimationSpec animation;  // cases/animation_spec.h
+  AnimationSpec animation;  // cases/output/animation_spec.h
   // What the scene was read from (null for a scene built in code), for set_parameter.
   std::shared_ptr<const SceneSource> source;
 };

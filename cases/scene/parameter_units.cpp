@@ -1,5 +1,5 @@
 // Units of scene parameters (cases/parameter_units.h), from docs/scene-format.md.
-#include "cases/parameter_units.h"
+#include "cases/scene/parameter_units.h"
 
 #include <cctype>
 #include <map>

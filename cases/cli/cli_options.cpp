@@ -1,12 +1,12 @@
-#include "cases/cli_options.h"
+#include "cases/cli/cli_options.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "cases/analysis_types.h"
-#include "cases/field_ranges.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/scene/field_ranges.h"
 
 namespace mbdae {
 namespace {

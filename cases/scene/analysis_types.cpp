@@ -1,9 +1,9 @@
-#include "cases/analysis_types.h"
+#include "cases/scene/analysis_types.h"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "cases/run_stages.h"
+#include "cases/run/run_stages.h"
 
 namespace mbdae {
 namespace {

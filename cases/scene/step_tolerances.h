@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "formulation/tolerance_scales.h"
 
 namespace mbdae {

@@ -1,10 +1,10 @@
-// run() (cases/mbdae.h): the scene's analyses in order, over the stages of cases/run_stages.h.
+// run() (cases/mbdae.h): the scene's analyses in order, over the stages of cases/run/run_stages.h.
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
-#include "cases/analysis_types.h"
-#include "cases/run_stages.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/run/run_stages.h"
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/augmented_solver.h"

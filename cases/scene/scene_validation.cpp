@@ -1,9 +1,9 @@
-#include "cases/scene_validation.h"
+#include "cases/scene/scene_validation.h"
 
 #include <algorithm>
 #include <set>
 
-#include "cases/analysis_types.h"
+#include "cases/scene/analysis_types.h"
 #include "core/errors.h"
 #include "core/expression.h"
 #include "formulation/forces.h"

@@ -1,4 +1,4 @@
-#include "cases/error_estimate.h"
+#include "cases/run/error_estimate.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "cases/animation_sink.h"
+#include "cases/output/animation_sink.h"
 
 #include <cmath>
 #include <cstdio>

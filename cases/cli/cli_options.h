@@ -1,11 +1,11 @@
-// The command line of mbdae (cases/main.cpp):
+// The command line of mbdae (cases/cli/main.cpp):
 //   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet] [--error-estimate]
 //                         [--formulation index3|index2-ggl|index1|penalty]
 //                         [--animation] [--animation-rate HZ]
 //   mbdae check SCENE.yaml
 //   mbdae params SCENE.yaml     (every parameter path with its value and unit)
 //   mbdae --version
-// Overrides are checked with the scene fields' own range checks (cases/field_ranges.h): the
+// Overrides are checked with the scene fields' own range checks (cases/scene/field_ranges.h): the
 // tolerances as soon as they are read, the output step against each integration step's time
 // span once the scene is loaded.
 #pragma once
@@ -25,8 +25,8 @@ struct CommandLine {
   std::string out_dir;  // --out: results.csv and summary.json go there
   RunOptions options;
   bool show_usage = false;  // after an error: the usage text helps
-  bool error_estimate = false;  // --error-estimate (cases/error_estimate.h)
-  bool animation = false;     // --animation: DIR/animation.pvd (cases/animation_sink.h)
+  bool error_estimate = false;  // --error-estimate (cases/run/error_estimate.h)
+  bool animation = false;     // --animation: DIR/animation.pvd (cases/output/animation_sink.h)
   double animation_rate = 0;  // --animation-rate HZ (implies --animation)
 };
 

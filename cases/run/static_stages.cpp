@@ -1,9 +1,9 @@
-// The static stages of a run: assembly and equilibrium (cases/run_stages.h).
+// The static stages of a run: assembly and equilibrium (cases/run/run_stages.h).
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
-#include "cases/run_stages.h"
+#include "cases/run/run_stages.h"
 #include "core/errors.h"
 #include "formulation/analyses.h"
 #include "formulation/assembly_mode.h"

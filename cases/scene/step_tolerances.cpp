@@ -1,4 +1,4 @@
-#include "cases/step_tolerances.h"
+#include "cases/scene/step_tolerances.h"
 
 namespace mbdae {
 

@@ -1,5 +1,5 @@
-// Parameter overrides on the parsed YAML trees (cases/scene_overrides.h).
-#include "cases/scene_overrides.h"
+// Parameter overrides on the parsed YAML trees (cases/scene/scene_overrides.h).
+#include "cases/scene/scene_overrides.h"
 
 #include <algorithm>
 #include <cctype>
@@ -7,8 +7,8 @@
 #include <set>
 #include <vector>
 
-#include "cases/parameter_units.h"
-#include "cases/scene.h"
+#include "cases/scene/parameter_units.h"
+#include "cases/scene/scene.h"
 #include "core/errors.h"
 
 namespace mbdae {

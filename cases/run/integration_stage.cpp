@@ -1,4 +1,4 @@
-// The integration stage of a run (kinematics or dynamics; cases/run_stages.h): the step's
+// The integration stage of a run (kinematics or dynamics; cases/run/run_stages.h): the step's
 // formulation from the registry, consistent initial values, IDA, and every output sample
 // evaluated once into the Result's columns and handed to the sinks.
 #include <algorithm>
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "cases/analysis_types.h"
-#include "cases/failure_diagnosis.h"
-#include "cases/run_stages.h"
-#include "cases/step_tolerances.h"
+#include "cases/scene/analysis_types.h"
+#include "cases/run/failure_diagnosis.h"
+#include "cases/run/run_stages.h"
+#include "cases/scene/step_tolerances.h"
 #include "core/errors.h"
 #include "core/finite_check.h"
 #include "core/ida_driver.h"

@@ -1,4 +1,4 @@
-#include "cases/sinks.h"
+#include "cases/output/sinks.h"
 
 namespace mbdae {
 

@@ -10,12 +10,12 @@
 #include <new>
 #include <string>
 
-#include "cases/animation_sink.h"
-#include "cases/cli_options.h"
-#include "cases/error_estimate.h"
+#include "cases/output/animation_sink.h"
+#include "cases/cli/cli_options.h"
+#include "cases/run/error_estimate.h"
 #include "cases/mbdae.h"
-#include "cases/sinks.h"
-#include "cases/signals.h"
+#include "cases/output/sinks.h"
+#include "cases/run/signals.h"
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/system.h"
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     mbdae::CsvSink csv(cl.out_dir + "/results.csv");
     mbdae::SummarySink summary(cl.out_dir + "/summary.json");
     std::vector<mbdae::Sink*> sinks = {&csv, &summary};
-    std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/animation_sink.h)
+    std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/output/animation_sink.h)
     if (cl.animation || scene.animation.write)
       anim = std::make_unique<mbdae::AnimationSink>(scene, cl.out_dir, cl.animation_rate);
     if (anim) sinks.push_back(anim.get());
