@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/scene.h"  // ParameterEntry
+#include "cases/scene/scene.h"  // ParameterEntry
 
 namespace mbdae {
 

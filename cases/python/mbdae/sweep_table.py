@@ -74,8 +74,7 @@ def _manifest(out):
 
 def read_sweep(out):
     """The table of a sweep folder (OUT/runs.csv) with its units (attrs["units"])."""
-    table = SweepTable(pd.read_csv(Path(out) / "runs.csv", float_precision="round_trip", keep_default_na=False,
-                                   na_values=["", "nan", "NaN"]))
+    table = SweepTable(pd.read_csv(Path(out) / "runs.csv", float_precision="round_trip"))
     table.attrs["units"] = _manifest(out).get("units", {})
     return table
 
@@ -117,6 +116,10 @@ def runs_dataset(out, columns=None):
     coords = {"run": np.arange(len(m["runs"])), "t": ("t", t, {"units": units.get("t", "s")}),
               "status": ("run", table["status"].astype(str).to_numpy())}
     for p in dict.fromkeys(p for e in m["runs"] for p in e["params"]):
-        coords[p] = ("run", np.array([e["params"].get(p, np.nan) for e in m["runs"]], dtype=object),
-                     {"units": m.get("units", {}).get(p, "")})
+        values = [e["params"].get(p, np.nan) for e in m["runs"]]
+        try:
+            values = np.array(values, dtype=float)  # numbers as numbers (netCDF-writable)
+        except (TypeError, ValueError):
+            values = np.array([str(v) for v in values])
+        coords[p] = ("run", values, {"units": m.get("units", {}).get(p, "")})
     return xr.Dataset(data, coords=coords, attrs={"sweep": str(out)})
