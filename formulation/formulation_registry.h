@@ -16,7 +16,7 @@ namespace mbdae {
 struct FormulationParameters {
   double constraint_scale = 1.0;                     // row scale of the constraint equations
   double baumgarte_alpha = 20.0, baumgarte_beta = 20.0;  // [1/s] stabilization (index1, penalty);
-                                                         // a run derives them from the model (cases/step_tolerances.h)
+                                                         // a run derives them from the model (cases/scene/step_tolerances.h)
   double penalty = 1e7;  // p = penalty * largest body mass (penalty)
 };
 

@@ -58,14 +58,9 @@ int main(int argc, char** argv) {
     const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, opt);
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
-    const mbdae::OutputFolderLock lock = mbdae::claim_output_folder(cl.out_dir, {"results.csv", "summary.json"});
-    mbdae::CsvSink csv(cl.out_dir + "/results.csv");
-    mbdae::SummarySink summary(cl.out_dir + "/summary.json");
-    std::vector<mbdae::Sink*> sinks = {&csv, &summary};
-    std::unique_ptr<mbdae::AnimationSink> anim;  // DIR/animation.pvd (cases/output/animation_sink.h)
-    if (cl.animation || scene.animation.write)
-      anim = std::make_unique<mbdae::AnimationSink>(scene, cl.out_dir, cl.animation_rate);
-    if (anim) sinks.push_back(anim.get());
+    const bool animate = cl.animation || scene.animation.write;  // DIR/animation.pvd
+    mbdae::RunSinks out = mbdae::open_sinks(scene, {cl.out_dir, animate ? cl.out_dir : "", cl.animation_rate});
+    const std::vector<mbdae::Sink*>& sinks = out.list;
     const bool estimate = cl.error_estimate || mbdae::error_estimate_requested(scene);
     const mbdae::Result r = estimate ? mbdae::run_with_error_estimate(scene, opt, sinks, cl.out_dir + "/summary.json")
                                      : mbdae::run(scene, opt, sinks);  // load, run, write

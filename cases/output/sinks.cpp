@@ -13,4 +13,20 @@ void CsvSink::end(const Result&) { csv_.close(); }
 
 void SummarySink::end(const Result& result) { write_json_file(path_, result.summary); }
 
+RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
+  RunSinks s;
+  if (!request.out_dir.empty()) {
+    s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
+    s.csv = std::make_unique<CsvSink>(request.out_dir + "/results.csv");
+    s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
+    s.list = {s.csv.get(), s.summary.get()};
+  }
+  if (!request.animation_dir.empty()) {
+    if (request.animation_dir != request.out_dir) prepare_output_folder(request.animation_dir);
+    s.animation = std::make_unique<AnimationSink>(scene, request.animation_dir, request.animation_rate);
+    s.list.push_back(s.animation.get());
+  }
+  return s;
+}
+
 }  // namespace mbdae

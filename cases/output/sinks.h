@@ -3,9 +3,12 @@
 // written when the run ends, whether it succeeded or not).
 #pragma once
 
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "cases/mbdae.h"
+#include "cases/output/animation_sink.h"
 #include "core/output.h"
 
 namespace mbdae {
@@ -33,5 +36,27 @@ class SummarySink : public Sink {
  private:
   std::string path_;
 };
+
+// What a run writes besides its Result: results.csv and summary.json into `out_dir`, the
+// animation into `animation_dir` (each empty: not written).
+struct OutputRequest {
+  std::string out_dir;
+  std::string animation_dir;
+  double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
+};
+
+// The sinks of one run and the lock of its output folder, held until the run ends. The one
+// factory of writers: the CLI and the Python package both call open_sinks.
+struct RunSinks {
+  OutputFolderLock lock;
+  std::unique_ptr<CsvSink> csv;
+  std::unique_ptr<SummarySink> summary;
+  std::unique_ptr<AnimationSink> animation;
+  std::vector<Sink*> list;  // what run() takes
+};
+
+// Claims the output folder (claim_output_folder: lock, previous summary.json removed) and makes
+// the sinks of `request`. Throws OutputError when the folder is in use or cannot be written.
+RunSinks open_sinks(const Scene& scene, const OutputRequest& request);
 
 }  // namespace mbdae

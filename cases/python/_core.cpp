@@ -32,24 +32,11 @@ struct PyRunOptions : mbdae::RunOptions {
   double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
 };
 
-// mbdae::run with the CLI's sinks when an output folder is given, and the animation sink.
+// mbdae::run with the CLI's sinks (open_sinks, cases/output/sinks.h: the same folder lock) when an
+// output folder is given, and the animation sink.
 mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
-  std::vector<mbdae::Sink*> sinks;
-  std::unique_ptr<mbdae::CsvSink> csv;
-  std::unique_ptr<mbdae::SummarySink> summary;
-  std::unique_ptr<mbdae::AnimationSink> animation;
-  if (!options.out_dir.empty()) {
-    mbdae::prepare_output_folder(options.out_dir);
-    csv = std::make_unique<mbdae::CsvSink>(options.out_dir + "/results.csv");
-    summary = std::make_unique<mbdae::SummarySink>(options.out_dir + "/summary.json");
-    sinks = {csv.get(), summary.get()};
-  }
-  if (!options.animation_dir.empty()) {
-    mbdae::prepare_output_folder(options.animation_dir);
-    animation = std::make_unique<mbdae::AnimationSink>(scene, options.animation_dir, options.animation_rate);
-    sinks.push_back(animation.get());
-  }
-  return mbdae::run(scene, options, sinks);
+  mbdae::RunSinks out = mbdae::open_sinks(scene, {options.out_dir, options.animation_dir, options.animation_rate});
+  return mbdae::run(scene, options, out.list);
 }
 
 // A column of a Result as a read-only numpy array over the Result's own memory (no copy): the

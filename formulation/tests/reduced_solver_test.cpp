@@ -20,7 +20,7 @@
 #include "core/ida_driver.h"
 #include "core/klu_solver.h"
 #include "core/reduced_linear_solver.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "core/sundials_compat.h"
 #include "formulation/ggl_dae.h"
 #include "formulation/index1_dae.h"

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "formulation/analyses.h"
 #include "formulation/system.h"
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "core/klu_solver.h"
 #include "formulation/analyses.h"
 #include "formulation/index3_dae.h"

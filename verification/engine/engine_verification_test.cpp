@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "formulation/tests/pendulum_reference.h"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cases/error_estimate.h"
+#include "cases/run/error_estimate.h"
 #include "verification/fast_mechanism/fast_mechanism_errors.h"
 #include "verification/fast_mechanism/slider_crank_reference.h"
 
@@ -78,7 +78,7 @@ TEST(FastMechanism, Index3ErrorPerUnitStepBeatsPositionsOnly) {
   EXPECT_LT(1000 * unit_step.velocity, positions.velocity);
 }
 
-// The error estimate (cases/error_estimate.h) finds the error of a formulation that misses the
+// The error estimate (cases/run/error_estimate.h) finds the error of a formulation that misses the
 // promise (index2-ggl) within a factor 3 and warns.
 TEST(FastMechanism, ErrorEstimateSeesTheMissedPromise) {
   const Scene scene = load_fast_mechanism();

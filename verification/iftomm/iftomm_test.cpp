@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 
 namespace {
 

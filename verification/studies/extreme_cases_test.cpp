@@ -16,7 +16,7 @@
 #include <Eigen/SVD>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "verification/reference/suspension_reference.h"
 
 namespace mbdae {

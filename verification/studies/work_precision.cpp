@@ -45,7 +45,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "core/errors.h"
 
 namespace {

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "cases/mbdae.h"
-#include "cases/scene.h"
+#include "cases/scene/scene.h"
 #include "core/errors.h"
 #include "verification/reference/suspension_reference.h"
 
