@@ -200,7 +200,7 @@ def sweep(scene, params, out, client=None, metrics=None, options=None, workers=N
     OSError) and keeps the runs finished before whole."""
     runs, options, metrics = expand(params), dict(options or {}), dict(metrics or {})
     check_options(options)
-    workers = check_workers(workers)
+    workers = check_workers(workers, client)
     if workers is not None and client not in (None, "threads", "processes"):
         raise ValueError("workers applies to local runs (client None, 'threads' or 'processes'), not to a given "
                          "Dask cluster (its workers are started with it)")

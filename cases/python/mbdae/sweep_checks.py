@@ -5,6 +5,7 @@ import difflib
 import hashlib
 import json
 import numbers
+import os
 from pathlib import Path
 
 import numpy as np
@@ -79,11 +80,17 @@ def check_metrics(scene, metrics):
                                  f"'{c}'{suggestion(c, columns)} (columns: {', '.join(columns)})")
 
 
-def check_workers(workers):
+def check_workers(workers, client=None):
+    """A local worker count: a whole number from 1 to 1024 threads, or to 4 per core for
+    processes (each a Python interpreter of its own)."""
     if workers is None:
         return None
     if isinstance(workers, bool) or not isinstance(workers, numbers.Integral) or workers < 1:
         raise ValueError(f"workers expects a whole number >= 1 (local workers), got {workers!r}")
+    limit = 4 * (os.cpu_count() or 1) if client == "processes" else 1024
+    if workers > limit:
+        raise ValueError(f"workers: {workers} is more than {limit} local "
+                         f"{'processes (4 per core)' if client == 'processes' else 'threads'}")
     return int(workers)
 
 

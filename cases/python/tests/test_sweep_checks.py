@@ -164,6 +164,14 @@ def test_workers_is_range_checked(tmp_path, workers):
     assert no_runs_started(tmp_path)
 
 
+def test_workers_has_an_upper_bound(tmp_path):
+    with pytest.raises(ValueError, match="more than 1024 local threads"):
+        mbdae.sweep(short_scene(), GRID, out=tmp_path, workers=100000, progress=False)
+    with pytest.raises(ValueError, match=r"local processes \(4 per core\)"):
+        mbdae.sweep(short_scene(), GRID, out=tmp_path, workers=100000, client="processes", progress=False)
+    assert no_runs_started(tmp_path)
+
+
 @pytest.mark.parametrize("workers", ["0", "-1"])
 def test_shell_workers_is_range_checked(tmp_path, workers):
     p = subprocess.run([sys.executable, "-m", "mbdae", "sweep", str(STEP), "--out", str(tmp_path), "--workers",
