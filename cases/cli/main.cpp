@@ -5,7 +5,9 @@
 // Exit codes (docs/errors.md): 0 success, 1 usage, 2 invalid scene, 3 solve failure, 4 output
 // or resource failure (a file that cannot be written, a folder in use, out of memory),
 // 128 + N stopped by signal N (SIGINT 130, SIGTERM 143).
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <string>
@@ -23,11 +25,14 @@
 
 namespace {
 
-// mbdae params: one line per parameter path, "path = value [unit]", in the scene's order.
+// mbdae params: one line per parameter path, "path = value [unit]", in the scene's order; a
+// stdout that cannot be written (a full device) is exit code 4 with a message.
 int print_parameters(const mbdae::Scene& scene) {
   for (const auto& p : mbdae::parameters(scene))
     std::printf("%s = %s%s\n", p.path.c_str(), p.value.c_str(), p.unit.empty() ? "" : (" [" + p.unit + "]").c_str());
-  return std::fflush(stdout) == 0 && !std::ferror(stdout) ? 0 : 4;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return 0;
+  std::fprintf(stderr, "mbdae: cannot write the parameter list to stdout (%s)\n", std::strerror(errno));
+  return 4;
 }
 
 }  // namespace
