@@ -103,16 +103,27 @@ int root_fn(sunrealtype t, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
   return 0;
 }
 
+// Every SUNDIALS call that returns a flag goes through check: a negative flag (a setting IDA
+// refused, memory it could not get) ends the run as an internal error naming the call.
+void check(int flag, const char* call) {
+  if (flag < 0) throw SolveError("internal_error", std::string(call) + " failed (" + ida_flag_name(flag) + ")");
+}
+template <class T>
+T check(T made, const char* call) {
+  if (!made) throw SolveError("internal_error", std::string(call) + " returned nothing (out of memory?)");
+  return made;
+}
+
 // IDA's counters restart at every IDAReInit: add them up before each one.
 void collect(void* mem, IdaStats& s) {
   long v;
-  IDAGetNumSteps(mem, &v); s.steps += v;
-  IDAGetNumResEvals(mem, &v); s.residual_evals += v;
-  IDAGetNumJacEvals(mem, &v); s.jacobian_evals += v;
-  IDAGetNumLinSolvSetups(mem, &v); s.linear_setups += v;
-  IDAGetNumErrTestFails(mem, &v); s.error_test_failures += v;
-  IDAGetNumNonlinSolvIters(mem, &v); s.nonlinear_iterations += v;
-  IDAGetNumNonlinSolvConvFails(mem, &v); s.nonlinear_failures += v;
+  check(IDAGetNumSteps(mem, &v), "IDAGetNumSteps"); s.steps += v;
+  check(IDAGetNumResEvals(mem, &v), "IDAGetNumResEvals"); s.residual_evals += v;
+  check(IDAGetNumJacEvals(mem, &v), "IDAGetNumJacEvals"); s.jacobian_evals += v;
+  check(IDAGetNumLinSolvSetups(mem, &v), "IDAGetNumLinSolvSetups"); s.linear_setups += v;
+  check(IDAGetNumErrTestFails(mem, &v), "IDAGetNumErrTestFails"); s.error_test_failures += v;
+  check(IDAGetNumNonlinSolvIters(mem, &v), "IDAGetNumNonlinSolvIters"); s.nonlinear_iterations += v;
+  check(IDAGetNumNonlinSolvConvFails(mem, &v), "IDAGetNumNonlinSolvConvFails"); s.nonlinear_failures += v;
   double h = 0;
   if (IDAGetLastStep(mem, &h) == IDA_SUCCESS && h != 0) s.last_step = h;
 }
@@ -187,28 +198,28 @@ void choose_initial_step(IdaRun& r, double tt) {
 
 void configure_ida(IdaRun& r) {
   const IdaOptions& o = *r.o;
-  IDAInit(r.mem, residual_fn, o.t0, r.y, r.yp);
-  IDAWFtolerances(r.mem, weights_fn);
-  IDASetUserData(r.mem, &r.ud);
-  keep_ida_errors(r.mem, r.ctx, &r.ud.last_ida_error);
-  IDASetId(r.mem, r.id);
-  IDASetSuppressAlg(r.mem, SUNTRUE);
-  IDASetLinearSolver(r.mem, r.ls, r.jac);
-  IDASetJacFn(r.mem, jacobian_fn);
-  IDASetMaxNumSteps(r.mem, o.max_steps);
-  IDASetMaxOrd(r.mem, o.max_order);
-  IDASetNonlinConvCoef(r.mem, o.nonlinear_convergence);
+  check(IDAInit(r.mem, residual_fn, o.t0, r.y, r.yp), "IDAInit");
+  check(IDAWFtolerances(r.mem, weights_fn), "IDAWFtolerances");
+  check(IDASetUserData(r.mem, &r.ud), "IDASetUserData");
+  check(keep_ida_errors(r.mem, r.ctx, &r.ud.last_ida_error), "IDASetErrHandlerFn");
+  check(IDASetId(r.mem, r.id), "IDASetId");
+  check(IDASetSuppressAlg(r.mem, SUNTRUE), "IDASetSuppressAlg");
+  check(IDASetLinearSolver(r.mem, r.ls, r.jac), "IDASetLinearSolver");
+  check(IDASetJacFn(r.mem, jacobian_fn), "IDASetJacFn");
+  check(IDASetMaxNumSteps(r.mem, o.max_steps), "IDASetMaxNumSteps");
+  check(IDASetMaxOrd(r.mem, o.max_order), "IDASetMaxOrd");
+  check(IDASetNonlinConvCoef(r.mem, o.nonlinear_convergence), "IDASetNonlinConvCoef");
   // Refresh the Newton matrix whenever cj changes by more than delta_cj: with index-3 rows the
   // matrix does not scale with cj, and IDA's rescaled old-matrix corrections fail to converge.
-  IDASetDeltaCjLSetup(r.mem, o.delta_cj);
-  if (o.max_step > 0) IDASetMaxStep(r.mem, o.max_step);
+  check(IDASetDeltaCjLSetup(r.mem, o.delta_cj), "IDASetDeltaCjLSetup");
+  if (o.max_step > 0) check(IDASetMaxStep(r.mem, o.max_step), "IDASetMaxStep");
   // IDA's own first step, 0.5/|y'|, uses accelerations and is far too small for a multibody
   // system at index 3; start from the problem's estimate instead (the error test adapts it).
-  IDASetInitStep(r.mem, r.ud.h_initial);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
   r.nsw = r.problem->num_switches();
   if (r.nsw > 0) {
-    IDARootInit(r.mem, r.nsw, root_fn);
-    IDASetNoInactiveRootWarn(r.mem);
+    check(IDARootInit(r.mem, r.nsw, root_fn), "IDARootInit");
+    check(IDASetNoInactiveRootWarn(r.mem), "IDASetNoInactiveRootWarn");
   }
   r.roots.assign(std::max(1, r.nsw), 0);
 }
@@ -228,14 +239,14 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.n = r.problem->size();
   r.ctx = make_sun_context();
   if (!r.ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
-  for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) *v = N_VNew_Serial(r.n, r.ctx);
+  for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) *v = check(N_VNew_Serial(r.n, r.ctx), "N_VNew_Serial");
   std::memcpy(data(r.y), y0.data(), r.n * sizeof(double));
   std::memcpy(data(r.yp), yp0.data(), r.n * sizeof(double));
   r.problem->error_test_mask(data(r.id));
   const CscPattern& pattern = r.problem->jacobian_pattern();
-  r.jac = SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx);
+  r.jac = check(SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx), "SUNSparseMatrix");
   r.ls = make_newton_linear_solver(pattern, o.reduced_newton ? r.problem->kinematic_rows() : 0, r.ctx);
-  r.mem = IDACreate(r.ctx);
+  r.mem = check(IDACreate(r.ctx), "IDACreate");
   r.ud.problem = r.problem;
   r.ud.pattern = &pattern;
   r.ud.mem = r.mem;
@@ -283,7 +294,7 @@ bool interpolate(IdaRun& r, double tt, int k, N_Vector v) {
 // IDA stopped with an error: the message names the worst error estimates and IDA's own words.
 void ida_failure(IdaRun& r, int flag) {
   double tt = r.t;
-  IDAGetCurrentTime(r.mem, &tt);
+  check(IDAGetCurrentTime(r.mem, &tt), "IDAGetCurrentTime");
   if (r.ud.non_finite >= 0) {
     const int i = r.ud.non_finite;
     const SolveError e =
@@ -294,7 +305,7 @@ void ida_failure(IdaRun& r, int flag) {
     return fail(r, "internal_error", "the DAE's " + r.ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
   std::ostringstream os;
   double h = 0;
-  IDAGetCurrentStep(r.mem, &h);
+  check(IDAGetCurrentStep(r.mem, &h), "IDAGetCurrentStep");
   os << "IDA failed at t = " << tt << " with step size " << h << " (" << ida_flag_name(flag) << ")";
   const std::string worst = worst_components(r.mem, *r.problem, r.ys, r.yps, r.id);
   if (!worst.empty()) os << "; largest error estimates: " << worst;
@@ -357,7 +368,7 @@ void keep_step(IdaRun& r) {
 // IDA's counters restart at every IDAReInit: add them up first (and once more at the end).
 void reinit(IdaRun& r, double tt) {
   collect(r.mem, r.stats);
-  IDAReInit(r.mem, tt, r.y, r.yp);
+  check(IDAReInit(r.mem, tt, r.y, r.yp), "IDAReInit");
 }
 
 // A step past t1: the end state and the last samples are interpolated; a root beyond t1 is no
@@ -378,10 +389,10 @@ bool step_onto_root(IdaRun& r, double t_root) {
   if (r.ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
     std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
     std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
-    IDASetInitStep(r.mem, r.ud.h_initial);
+    check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
     reinit(r, r.t_prev);
-    IDARootInit(r.mem, 0, nullptr);
-    IDASetStopTime(r.mem, t_root);
+    check(IDARootInit(r.mem, 0, nullptr), "IDARootInit");
+    check(IDASetStopTime(r.mem, t_root), "IDASetStopTime");
     r.t = r.t_prev;
   } else {
     r.t = t_root;  // the root is at the last step: its state is that step's
@@ -395,9 +406,9 @@ bool step_onto_root(IdaRun& r, double t_root) {
     r.problem->after_step(r.t, data(r.y));
     emit_until(r, r.t);
   }
-  IDARootInit(r.mem, r.nsw, root_fn);
+  check(IDARootInit(r.mem, r.nsw, root_fn), "IDARootInit");
   r.ud.h_initial = h_default;
-  IDASetInitStep(r.mem, r.ud.h_initial);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
   if (flag < 0) ida_failure(r, flag);
   if (!r.stats.ok) return false;
   r.stats.event_times.push_back(r.t);
@@ -418,9 +429,9 @@ bool restart(IdaRun& r, const int* roots) {
   if (!finite(r, data(r.y), r.t, "") || !finite(r, data(r.yp), r.t, "derivative of ")) return false;
   ++r.stats.restarts;
   choose_initial_step(r, r.t);
-  IDASetInitStep(r.mem, r.ud.h_initial);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
   reinit(r, r.t);
-  IDASetStopTime(r.mem, next_stop(r));
+  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
   keep_step(r);
   return true;
 }
@@ -444,7 +455,7 @@ bool advance(IdaRun& r) {
                              std::fabs(tret - r.bps[r.next_bp]) <= 1e-12 * std::max(1.0, std::fabs(tret));
   const bool is_root = flag == IDA_ROOT_RETURN && !at_breakpoint;
   if (is_root) {
-    IDAGetRootInfo(r.mem, r.roots.data());
+    check(IDAGetRootInfo(r.mem, r.roots.data()), "IDAGetRootInfo");
     // A root that changes no mode (a switching function grazing zero) needs no restart.
     if (!r.problem->changes_mode(tret, data(r.y), r.roots.data())) return true;
     if (!step_onto_root(r, tret)) return false;
@@ -475,11 +486,16 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   // The first sample is the initial state.
   emit(r, o.t0, y0.data(), yp0.data());
   r.sample_index = 1;
-  IDASetStopTime(r.mem, next_stop(r));
+  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
   problem.set_segment(r.t, segment_end(r));
   while (!r.stop_requested && r.stats.ok && r.t < o.t1) {
     if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
-    if (!advance(r)) break;
+    try {
+      if (!advance(r)) break;
+    } catch (const SolveError& e) {  // a SUNDIALS call that failed (check)
+      fail(r, e.status, e.what(), r.t);
+      break;
+    }
   }
   collect(r.mem, r.stats);
   if (r.stats.ok) r.stats.t_reached = r.t;

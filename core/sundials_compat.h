@@ -53,15 +53,17 @@ inline void ida_error_handler(int code, const char*, const char* function, char*
 
 // IDA's error messages ("function: message") go to *last_error instead of stderr, where IDA
 // prints them by default (also under `mbdae run --quiet`). 6: IDA's own handler; 7: the
-// context's handler stack, cleared first (its default handler logs to stderr).
-inline void keep_ida_errors(void* ida_mem, SUNContext ctx, std::string* last_error) {
+// context's handler stack, cleared first (its default handler logs to stderr). Returns a
+// negative flag on failure.
+inline int keep_ida_errors(void* ida_mem, SUNContext ctx, std::string* last_error) {
 #if SUNDIALS_VERSION_MAJOR >= 7
   (void)ida_mem;
-  SUNContext_ClearErrHandlers(ctx);
-  SUNContext_PushErrHandler(ctx, detail::sun_error_handler, last_error);
+  if (const int flag = SUNContext_ClearErrHandlers(ctx)) return flag < 0 ? flag : -flag;
+  const int flag = SUNContext_PushErrHandler(ctx, detail::sun_error_handler, last_error);
+  return flag < 0 ? flag : -flag;
 #else
   (void)ctx;
-  IDASetErrHandlerFn(ida_mem, detail::ida_error_handler, last_error);
+  return IDASetErrHandlerFn(ida_mem, detail::ida_error_handler, last_error);
 #endif
 }
 

@@ -140,41 +140,6 @@ double wrap_angle(double a) {
   return a - kPi;
 }
 
-LocalState gather(const double* q, int bi, int bj) {
-  LocalState s;
-  if (bi >= 0) {
-    s.ri = Eigen::Map<const Vec3>(q + 7 * bi);
-    s.pi = Eigen::Map<const Vec4>(q + 7 * bi + 3);
-  }
-  if (bj >= 0) {
-    s.rj = Eigen::Map<const Vec3>(q + 7 * bj);
-    s.pj = Eigen::Map<const Vec4>(q + 7 * bj + 3);
-  }
-  return s;
-}
-
-Vec14 local_vector(const LocalState& s) {
-  Vec14 y;
-  y << s.ri, s.pi, s.rj, s.pj;
-  return y;
-}
-
-LocalState local_state(const Vec14& y) {
-  LocalState s;
-  s.ri = y.segment<3>(0);
-  s.pi = y.segment<4>(3);
-  s.rj = y.segment<3>(7);
-  s.pj = y.segment<4>(10);
-  return s;
-}
-
-Vec14 gather_local(const double* x, int bi, int bj) {
-  Vec14 v = Vec14::Zero();
-  if (bi >= 0) v.head<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bi);
-  if (bj >= 0) v.tail<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bj);
-  return v;
-}
-
 ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s) {
   const int bp = f.body_parent, bc = f.body_child;
   if (!f.rotation) {

@@ -24,13 +24,11 @@
 #include <string>
 
 #include "core/time_function.h"
+#include "formulation/body_point.h"
 #include "formulation/euler_parameters.h"
 
 namespace mbdae {
 
-using Vec14 = Eigen::Matrix<double, 14, 1>;
-using Row14 = Eigen::Matrix<double, 1, 14>;
-using Mat14 = Eigen::Matrix<double, 14, 14>;
 
 // A joint coordinate measured from the two bodies' poses.
 //  Rotation of a chain whose rotations (completed to three distinct axes ax[0..2]) give the
@@ -71,17 +69,6 @@ struct Constraint {
 
   int rows() const { return type == Type::kPoint ? (mask & 1) + (mask >> 1 & 1) + (mask >> 2 & 1) : 1; }
 };
-
-// Local coordinates of a constraint's two bodies, gathered from the global vector q.
-struct LocalState {
-  Vec3 ri = Vec3::Zero(), rj = Vec3::Zero();
-  Vec4 pi = Vec4(1, 0, 0, 0), pj = Vec4(1, 0, 0, 0);
-};
-LocalState gather(const double* q, int bi, int bj);
-Vec14 gather_local(const double* x, int bi, int bj);  // local 14-vector (zeros for ground)
-// A LocalState as the local 14-vector [ri, pi, rj, pj], and back.
-Vec14 local_vector(const LocalState& s);
-LocalState local_state(const Vec14& y);
 
 // Values of the constraint rows (1 or 3).
 void constraint_value(const Constraint& c, const LocalState& s, double t, double* value);

@@ -139,26 +139,13 @@ double sensor_value(const System& sys, int k, const std::vector<char>& modes, co
                     const double* v, const double* a, double t, const double* earlier) {
   const Sensor& s = sys.sensors[k];
   const int b = s.body;
-  Vec3 r = Vec3::Zero(), rd = Vec3::Zero(), rdd = Vec3::Zero();
-  Vec4 p(1, 0, 0, 0), pd = Vec4::Zero(), pdd = Vec4::Zero();
-  if (b >= 0) {
-    r = Eigen::Map<const Vec3>(q + 7 * b);
-    p = Eigen::Map<const Vec4>(q + 7 * b + 3);
-    rd = Eigen::Map<const Vec3>(v + 7 * b);
-    pd = Eigen::Map<const Vec4>(v + 7 * b + 3);
-    if (a) {
-      rdd = Eigen::Map<const Vec3>(a + 7 * b);
-      pdd = Eigen::Map<const Vec4>(a + 7 * b + 3);
-    }
-  }
+  const BodyPose x = body_pose(q, b), xd = body_pose(v, b, true);
   switch (s.type) {
-    case SensorSpec::Type::kPosition:
-      return (b < 0 ? s.point : Vec3(r + rotate(p, s.point)))[s.component];
-    case SensorSpec::Type::kVelocity:
-      return b < 0 ? 0.0 : (rd + B_matrix(p, s.point) * pd)[s.component];
+    case SensorSpec::Type::kPosition: return (b < 0 ? s.point : point_position(x, s.point))[s.component];
+    case SensorSpec::Type::kVelocity: return point_velocity(x, xd, s.point)[s.component];
     case SensorSpec::Type::kAcceleration:
-      return b < 0 ? 0.0 : (rdd + B_matrix(p, s.point) * pdd + B_matrix(pd, s.point) * pd)[s.component];
-    case SensorSpec::Type::kAxis: return (b < 0 ? s.axis : rotate(p, s.axis))[s.component];
+      return point_acceleration(x, xd, a ? body_pose(a, b, true) : body_pose(nullptr, -1, true), s.point)[s.component];
+    case SensorSpec::Type::kAxis: return (b < 0 ? s.axis : rotate(x.p, s.axis))[s.component];
     case SensorSpec::Type::kCoordinate: return coordinate_value(sys, s.target, q);
     case SensorSpec::Type::kCoordinateRate: return coordinate_rate(sys, s.target, q, v);
     case SensorSpec::Type::kForceLength: {

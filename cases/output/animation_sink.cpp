@@ -52,17 +52,9 @@ constexpr const char* kFolder = "animation";
 enum CellField { kPart, kBody, kIndex, kAxis, kForce, kForceMagnitude, kNumCellFields };
 const std::vector<std::string> kCellFieldNames = {"part", "body", "index", "axis", "force", "force_magnitude"};
 
-Vec3 world(const PlanPoint& p, const double* q) {
-  if (p.host < 0) return p.local;
-  const double* x = q + 7 * p.host;
-  return Vec3(x[0], x[1], x[2]) + rotate(Vec4(x[3], x[4], x[5], x[6]), p.local);
-}
+Vec3 world(const PlanPoint& p, const double* q) { return point_position(body_pose(q, p.host), p.local); }
 
-Mat3 host_rotation(int host, const double* q) {
-  if (host < 0) return Mat3::Identity();
-  const double* p = q + 7 * host + 3;
-  return rotation(Vec4(p[0], p[1], p[2], p[3]));
-}
+Mat3 host_rotation(int host, const double* q) { return rotation(body_pose(q, host).p); }
 
 int body_index(const AnimationPlan& plan, const std::string& name) {
   for (size_t b = 0; b < plan.bodies.size(); ++b)

@@ -229,5 +229,23 @@ TEST(IdaDriver, OutputErrorStopsTheRun) {
   EXPECT_DOUBLE_EQ(st.t_reached, 0.5);
 }
 
+// A setting IDA refuses (its maximum order must be 1 to 5) is an internal error naming the call,
+// not a run that goes on with IDA's default (every SUNDIALS flag goes through one check).
+TEST(IdaDriver, RefusedSettingNamesTheSundialsCall) {
+  DecayProblem p;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.max_order = 0;
+  try {
+    integrate(p, o, y, yp, [](double, const double*, const double*) { return true; });
+    FAIL() << "a maximum order of 0 was accepted";
+  } catch (const SolveError& e) {
+    EXPECT_EQ(e.status, "internal_error");
+    EXPECT_NE(std::string(e.what()).find("IDASetMaxOrd"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("IDA_ILL_INPUT"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mbdae

@@ -1,0 +1,60 @@
+// Body and body-point kinematics (formulation/body_point.h).
+#include "formulation/body_point.h"
+
+namespace mbdae {
+
+BodyPose body_pose(const double* x, int b, bool rates) {
+  BodyPose s;
+  if (rates) s.p = Vec4::Zero();
+  if (b < 0) return s;
+  s.r = Eigen::Map<const Vec3>(x + 7 * b);
+  s.p = Eigen::Map<const Vec4>(x + 7 * b + 3);
+  return s;
+}
+
+Vec3 point_position(const BodyPose& q, const Vec3& s) { return q.r + rotate(q.p, s); }
+
+Vec3 point_velocity(const BodyPose& q, const BodyPose& v, const Vec3& s) {
+  return v.r + B_matrix(q.p, s) * v.p;
+}
+
+Vec3 point_acceleration(const BodyPose& q, const BodyPose& v, const BodyPose& a, const Vec3& s) {
+  return a.r + B_matrix(q.p, s) * a.p + B_matrix(v.p, s) * v.p;
+}
+
+LocalState gather(const double* q, int bi, int bj) {
+  LocalState s;
+  if (bi >= 0) {
+    s.ri = Eigen::Map<const Vec3>(q + 7 * bi);
+    s.pi = Eigen::Map<const Vec4>(q + 7 * bi + 3);
+  }
+  if (bj >= 0) {
+    s.rj = Eigen::Map<const Vec3>(q + 7 * bj);
+    s.pj = Eigen::Map<const Vec4>(q + 7 * bj + 3);
+  }
+  return s;
+}
+
+Vec14 local_vector(const LocalState& s) {
+  Vec14 y;
+  y << s.ri, s.pi, s.rj, s.pj;
+  return y;
+}
+
+LocalState local_state(const Vec14& y) {
+  LocalState s;
+  s.ri = y.segment<3>(0);
+  s.pi = y.segment<4>(3);
+  s.rj = y.segment<3>(7);
+  s.pj = y.segment<4>(10);
+  return s;
+}
+
+Vec14 gather_local(const double* x, int bi, int bj) {
+  Vec14 v = Vec14::Zero();
+  if (bi >= 0) v.head<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bi);
+  if (bj >= 0) v.tail<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bj);
+  return v;
+}
+
+}  // namespace mbdae
