@@ -86,19 +86,26 @@ std::shared_ptr<const System> build_checked_system(const Scene& scene, const Run
   return sys;
 }
 
+// The sensors written as columns: all, or the scene's `output` list.
+std::vector<int> column_sensors(const Scene& scene, const System& sys) {
+  std::vector<int> out;
+  if (scene.columns.empty()) {
+    for (size_t k = 0; k < sys.sensors.size(); ++k) out.push_back(static_cast<int>(k));
+    return out;
+  }
+  for (const auto& name : scene.columns) {
+    int idx = -1;
+    for (size_t k = 0; k < sys.sensors.size(); ++k)
+      if (sys.sensors[k].name == name) idx = static_cast<int>(k);
+    if (idx < 0) throw ModelError(scene.file, 0, "output", "no sensor named '" + name + "'");
+    out.push_back(idx);
+  }
+  return out;
+}
+
 void output_columns(RunContext& c) {
   const System& sys = *c.system;
-  if (c.scene.columns.empty()) {
-    for (size_t k = 0; k < sys.sensors.size(); ++k) c.column_sensors.push_back(static_cast<int>(k));
-  } else {
-    for (const auto& name : c.scene.columns) {
-      int idx = -1;
-      for (size_t k = 0; k < sys.sensors.size(); ++k)
-        if (sys.sensors[k].name == name) idx = static_cast<int>(k);
-      if (idx < 0) throw ModelError(c.scene.file, 0, "output", "no sensor named '" + name + "'");
-      c.column_sensors.push_back(idx);
-    }
-  }
+  c.column_sensors = column_sensors(c.scene, sys);
   c.result.columns = {"t"};
   c.result.units = {"s"};
   for (int k : c.column_sensors) {
@@ -148,6 +155,13 @@ void output_failed(RunContext& c, const std::string& message) {
   c.result.summary["status"] = c.result.status = "output_failed";
   c.result.summary["message"] = c.result.message = message;
   c.result.exit_code = 4;
+}
+
+std::vector<std::pair<std::string, std::string>> output_columns(const Scene& scene) {
+  const System sys = build_system(scene.model);
+  std::vector<std::pair<std::string, std::string>> out = {{"t", "s"}};
+  for (int k : column_sensors(scene, sys)) out.emplace_back(sys.sensors[k].name, sensor_unit(sys, sys.sensors[k]));
+  return out;
 }
 
 std::vector<std::string> formulations() {

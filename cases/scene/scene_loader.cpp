@@ -216,6 +216,23 @@ Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, 
   return load_source(std::move(src));
 }
 
+std::vector<ParameterEntry> scene_parameters(const Scene& scene) {
+  if (!scene.source)
+    throw SceneError({ModelError::format(scene.file, 0, "", "this scene was not loaded from YAML; it has no parameters")});
+  SceneSource src = *scene.source;
+  std::vector<SceneIssue> issues;
+  FieldLines lines;
+  const auto parsed = parse(src.text, src.path, issues);
+  if (!parsed || !parsed->IsMap()) throw SceneError(messages(issues));
+  YAML::Node root = *parsed;
+  Loader l{src.path, &issues, &lines};
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
+  if (l.has(root, "model")) read_model_tree(src, l, root, issues, mroot, model_path);
+  for (const auto& [p, v] : src.overrides) apply_override(root, src.path, mroot ? &*mroot : nullptr, model_path, p, v);
+  return list_parameters(root, src.path, mroot ? &*mroot : nullptr, model_path);
+}
+
 Scene load_scene(const std::string& path) {
   std::string why;
   const auto text = read_text_file(path, why);

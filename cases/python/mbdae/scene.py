@@ -155,6 +155,25 @@ class Scene:
     def __reduce__(self):
         return (_rebuild, (self._path, self._text, self.overrides))
 
+    # ---- Inspection -------------------------------------------------------------------------
+    def parameters(self):
+        """Every parameter path of the scene (and its model file) with its current value (YAML
+        text) and unit, from the resolver set() uses: [{"path", "value", "unit", "file", "line"}].
+        The same list as `mbdae params SCENE`."""
+        return [dict(p) for p in _scene_errors(_core.parameters, self._core)]
+
+    def output_columns(self):
+        """[(name, unit)] of the columns a run writes ("t", then the output sensors), without
+        running (the model is built)."""
+        return [tuple(c) for c in _scene_errors(_core.output_columns, self._core)]
+
+    def _repr_html_(self):
+        from html import escape
+        cols = ", ".join(f"{escape(n)} [{escape(u)}]" for n, u in self.output_columns())
+        over = "".join(f"<li>{escape(p)} = {escape(v)}</li>" for p, v in self.overrides)
+        return (f"<p><b>mbdae.Scene</b> {escape(str(self.file))}<br>steps: {escape(', '.join(self.steps))}<br>"
+                f"columns: {cols}</p>" + (f"<p>overrides:</p><ul>{over}</ul>" if over else ""))
+
 
 def _rebuild(path, text, overrides):
     scene = Scene.from_file(path) if text is None else Scene.from_yaml(text, path)
