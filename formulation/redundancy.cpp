@@ -3,6 +3,7 @@
 #include <SuiteSparseQR.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -117,6 +118,91 @@ System without_redundant_constraints(const System& sys, const RedundancyReport& 
     if (c.type == Constraint::Type::kPoint) c.mask = report.keep[k];
     out.constraints.push_back(c);
   }
+  return out;
+}
+
+}  // namespace mbdae
+
+namespace mbdae {
+namespace {
+
+// The cut's frame for its point rows: on body i unless it is ground (then body j, sides
+// swapped), z along the axis of a dot-1 row of the cut on that side (a revolute's or universal's
+// axis1), else the body's own axes. `names` gets the rows' labels.
+Constraint frame_side(const System& sys, const Constraint& pt, Mat3& axes, std::array<std::string, 3>& names) {
+  Constraint c = pt;
+  const bool swap = pt.bi < 0;
+  if (swap) {
+    std::swap(c.bi, c.bj);
+    std::swap(c.si, c.sj);
+  }
+  axes = Mat3::Identity();
+  for (int k = 0; k < 3; ++k) names[k] = sys.bodies[c.bi].name + " " + "xyz"[k];
+  for (const Constraint& d : sys.constraints) {
+    if (swap || d.owner != Constraint::Owner::kCut || d.owner_name != pt.owner_name ||
+        d.type != Constraint::Type::kDot1 || d.bi != pt.bi)
+      continue;
+    const Vec3 z = d.ai.normalized(), x = z.unitOrthogonal();
+    axes.col(0) = x;
+    axes.col(1) = z.cross(x);
+    axes.col(2) = z;
+    names = {"across axis1 (1)", "across axis1 (2)", "along axis1"};
+    break;
+  }
+  return c;
+}
+
+}  // namespace
+
+System with_body_frame_cut_points(const System& sys, const std::vector<std::string>& cuts) {
+  System out = sys;
+  out.constraints.clear();
+  for (const Constraint& c : sys.constraints) {
+    const bool pick = c.owner == Constraint::Owner::kCut && c.type == Constraint::Type::kPoint &&
+                      std::find(cuts.begin(), cuts.end(), c.owner_name) != cuts.end() &&
+                      (c.bi >= 0 || c.bj >= 0);
+    if (!pick) {
+      out.constraints.push_back(c);
+      continue;
+    }
+    Mat3 axes;
+    std::array<std::string, 3> names;
+    const Constraint side = frame_side(sys, c, axes, names);
+    // One dot-2 row per frame axis (a cut's point constraint has all three components).
+    for (int k = 0; k < 3; ++k) {
+      Constraint r = side;
+      r.type = Constraint::Type::kDot2;
+      r.ai = axes.col(k);
+      r.mask = 7;
+      r.label = c.label + " [" + names[k] + "]";
+      out.constraints.push_back(r);
+    }
+  }
+  return out;
+}
+
+EquationChoice choose_independent_equations(const System& sys, const double* q, double t, double tolerance) {
+  EquationChoice out;
+  const RedundancyReport first = find_redundant_constraints(sys, q, t, tolerance);
+  if (first.redundant.empty()) {
+    out.system = sys;
+    out.report = first;
+    return out;
+  }
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const int full = c.type == Constraint::Type::kPoint ? c.mask : 1;
+    if (c.owner != Constraint::Owner::kCut || first.keep[k] == full) continue;
+    const bool has_point = std::any_of(sys.constraints.begin(), sys.constraints.end(), [&](const Constraint& p) {
+      return p.owner == Constraint::Owner::kCut && p.owner_name == c.owner_name && p.type == Constraint::Type::kPoint;
+    });
+    if (!has_point) continue;
+    if (std::find(out.reexpressed.begin(), out.reexpressed.end(), c.owner_name) == out.reexpressed.end())
+      out.reexpressed.push_back(c.owner_name);
+  }
+  const System body_frame = with_body_frame_cut_points(sys, out.reexpressed);
+  out.report = find_redundant_constraints(body_frame, q, t, tolerance);
+  out.system = without_redundant_constraints(body_frame, out.report);
   return out;
 }
 
