@@ -216,9 +216,9 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
     const System& sys = *c.system;
     const FailureDiagnosis d = diagnose_integration_failure(
         sys, dae.modes, c.column_sensors, c.q.data(), y.data() + sys.nq(), st.t_reached, dae.input_time(st.t_reached),
-        dae.augmented().constraint_condition(c.q.data()), st.message);
+        dae.augmented().constraint_condition(c.q.data()), st.message, c.all_equations.get());
     for (const auto& [key, value] : d.details.items()) js[key] = value;
-    if (d.singular) {
+    if (d.singular || d.degraded_choice) {
       js["solver_message"] = st.message;
       message = d.message;
     }
