@@ -184,21 +184,19 @@ System with_body_frame_cut_points(const System& sys, const std::vector<std::stri
 EquationChoice choose_independent_equations(const System& sys, const double* q, double t, double tolerance) {
   EquationChoice out;
   const RedundancyReport first = find_redundant_constraints(sys, q, t, tolerance);
-  if (first.redundant.empty()) {
-    out.system = sys;
-    out.report = first;
-    return out;
-  }
+  // Cuts whose point equations are partly redundant: which components are kept depends on the
+  // frame they are written in. (All three redundant: the cut repeats a joint, in any frame.)
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
-    const int full = c.type == Constraint::Type::kPoint ? c.mask : 1;
-    if (c.owner != Constraint::Owner::kCut || first.keep[k] == full) continue;
-    const bool has_point = std::any_of(sys.constraints.begin(), sys.constraints.end(), [&](const Constraint& p) {
-      return p.owner == Constraint::Owner::kCut && p.owner_name == c.owner_name && p.type == Constraint::Type::kPoint;
-    });
-    if (!has_point) continue;
+    if (c.owner != Constraint::Owner::kCut || c.type != Constraint::Type::kPoint) continue;
+    if (first.keep[k] == 0 || first.keep[k] == c.mask) continue;
     if (std::find(out.reexpressed.begin(), out.reexpressed.end(), c.owner_name) == out.reexpressed.end())
       out.reexpressed.push_back(c.owner_name);
+  }
+  if (out.reexpressed.empty()) {
+    out.system = without_redundant_constraints(sys, first);
+    out.report = first;
+    return out;
   }
   const System body_frame = with_body_frame_cut_points(sys, out.reexpressed);
   out.report = find_redundant_constraints(body_frame, q, t, tolerance);

@@ -37,11 +37,11 @@ System without_redundant_constraints(const System& sys, const RedundancyReport& 
 // coincident-point equations are written in world components; in a loop whose plane turns (a
 // four-bar on a turntable, a governor's pinned links) the dependent combination is a body-fixed
 // direction (the loop's normal), so a choice of world components made at one configuration goes
-// singular a quarter turn later. Here the point equations of every cut with a redundant equation
-// are first re-expressed as three point-on-plane (dot-2) rows along a frame fixed in one of the
-// cut's bodies (z along the cut's axis1 where it has one), then the redundancy analysis runs
-// again: the rows set aside are then the loop's own out-of-plane rows in every configuration of
-// a planar loop. Cuts without redundant equations are left exactly as built.
+// singular a quarter turn later. Here the point equations of every cut with some (not all) of
+// its point components redundant are first re-expressed as three point-on-plane (dot-2) rows
+// along a frame fixed in one of the cut's bodies (z along the cut's axis1 where it has one), then
+// the redundancy analysis runs again: the rows set aside are then the loop's own out-of-plane
+// rows in every configuration of a planar loop. Other cuts are left exactly as built.
 struct EquationChoice {
   System system;                         // the equations kept
   RedundancyReport report;               // the analysis of the re-expressed system
