@@ -70,7 +70,13 @@ std::shared_ptr<const System> build_checked_system(const Scene& scene, const Run
   AugmentedSolver projector(*sys);
   projector.positions(qc.data(), 0.0, 1e-12, 100, 1e-10);
   const bool remove = scene.redundant_constraints != "fail";
-  EquationChoice choice = choose_independent_equations(*sys, qc.data(), 0.0);
+  EquationChoice choice;
+  if (scene.redundant_constraints == "remove_world") {
+    choice.report = find_redundant_constraints(*sys, qc.data(), 0.0);
+    choice.system = without_redundant_constraints(*sys, choice.report);
+  } else {
+    choice = choose_independent_equations(*sys, qc.data(), 0.0);
+  }
   const RedundancyReport& rr = choice.report;
   summary["redundant_constraints"] = {{"policy", scene.redundant_constraints},
                                       {"equations", rr.equations},
