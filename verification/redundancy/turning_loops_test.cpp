@@ -9,6 +9,7 @@
 // reference as rtol tightens (a loop opened by a degraded equation choice does not).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <tuple>
 
@@ -78,6 +79,36 @@ TEST_P(TurningLoop, RunsToTheEndWithTheRightMotion) {
   std::printf("%s %s, rtol %g: largest error / scale %.3g\n", c.scene, formulation.c_str(), rtol / 1000, et.worst);
   EXPECT_LT(30 * et.worst, e.worst) << formulation;
   EXPECT_LT(e.worst, 0.5) << formulation;  // not a different motion
+}
+
+// The former choice (redundant_constraints: remove_world, world components set aside at t = 0)
+// degrades at the first quarter turn of the four-bar. It is never `ok` with a wrong motion:
+// index3 fails where the kept equations go singular and the diagnosis says the choice degraded,
+// not the mechanism; index1 and penalty (which ended 1.3 rad off before the watch) stop at the
+// first sample where the equations set aside no longer hold.
+TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
+  Scene scene = load_turning_case(kTurntableFourBar);
+  scene.redundant_constraints = "remove_world";
+  RunOptions opt;
+  opt.progress = false;
+  opt.formulation = "index3";
+  const Result r3 = run(scene, opt);
+  EXPECT_EQ(r3.status, "integration_failed");
+  EXPECT_NE(r3.message.find("(a degraded equation choice, not a singular configuration)"), std::string::npos)
+      << r3.message;
+  const auto& step = r3.summary["steps"].back();
+  ASSERT_TRUE(step.contains("equation_choice")) << step.dump(1);
+  EXPECT_TRUE(step["equation_choice"]["degraded"].get<bool>());
+  EXPECT_EQ(step["equation_choice"]["set_aside_again"].get<int>(), 3);
+  const double t3 = step["t_reached"].get<double>();
+  EXPECT_NEAR(std::fmod(t3, 0.5), 0.25, 0.01) << t3;  // a quarter turn, the loop's normal along world x
+  for (const char* f : {"index1", "penalty"}) {
+    opt.formulation = f;
+    const Result r = run(scene, opt);
+    EXPECT_EQ(r.status, "integration_failed") << f;
+    EXPECT_NE(r.message.find("no longer hold at t = 0.25"), std::string::npos) << f << ": " << r.message;
+    EXPECT_EQ(r.rows(), 25u) << f;  // t = 0 ... 0.24; the sample at 0.25 is not written
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Formulations, TurningLoop,
