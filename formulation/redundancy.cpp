@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "formulation/mechanics.h"
 #include "formulation/normalized_jacobian.h"
@@ -126,10 +128,20 @@ System without_redundant_constraints(const System& sys, const RedundancyReport& 
 namespace mbdae {
 namespace {
 
+// The first dot-1 row of each cut (a revolute's or universal's axis1 on body i), by cut name.
+using CutAxes = std::unordered_map<std::string, const Constraint*>;
+CutAxes cut_axes(const System& sys) {
+  CutAxes out;
+  for (const Constraint& d : sys.constraints)
+    if (d.owner == Constraint::Owner::kCut && d.type == Constraint::Type::kDot1) out.emplace(d.owner_name, &d);
+  return out;
+}
+
 // The cut's frame for its point rows: on body i unless it is ground (then body j, sides
-// swapped), z along the axis of a dot-1 row of the cut on that side (a revolute's or universal's
-// axis1), else the body's own axes. `names` gets the rows' labels.
-Constraint frame_side(const System& sys, const Constraint& pt, Mat3& axes, std::array<std::string, 3>& names) {
+// swapped), z along the cut's dot-1 axis on that side (a revolute's or universal's axis1), else
+// the body's own axes. `names` gets the rows' labels.
+Constraint frame_side(const System& sys, const CutAxes& dot1, const Constraint& pt, Mat3& axes,
+                      std::array<std::string, 3>& names) {
   Constraint c = pt;
   const bool swap = pt.bi < 0;
   if (swap) {
@@ -138,36 +150,33 @@ Constraint frame_side(const System& sys, const Constraint& pt, Mat3& axes, std::
   }
   axes = Mat3::Identity();
   for (int k = 0; k < 3; ++k) names[k] = sys.bodies[c.bi].name + " " + "xyz"[k];
-  for (const Constraint& d : sys.constraints) {
-    if (swap || d.owner != Constraint::Owner::kCut || d.owner_name != pt.owner_name ||
-        d.type != Constraint::Type::kDot1 || d.bi != pt.bi)
-      continue;
-    const Vec3 z = d.ai.normalized(), x = z.unitOrthogonal();
-    axes.col(0) = x;
-    axes.col(1) = z.cross(x);
-    axes.col(2) = z;
-    names = {"across axis1 (1)", "across axis1 (2)", "along axis1"};
-    break;
-  }
+  const auto it = dot1.find(pt.owner_name);
+  if (swap || it == dot1.end() || it->second->bi != pt.bi) return c;
+  const Vec3 z = it->second->ai.normalized(), x = z.unitOrthogonal();
+  axes.col(0) = x;
+  axes.col(1) = z.cross(x);
+  axes.col(2) = z;
+  names = {"across axis1 (1)", "across axis1 (2)", "along axis1"};
   return c;
 }
 
 }  // namespace
 
 System with_body_frame_cut_points(const System& sys, const std::vector<std::string>& cuts) {
+  const std::unordered_set<std::string> picked(cuts.begin(), cuts.end());
+  const CutAxes dot1 = cut_axes(sys);
   System out = sys;
   out.constraints.clear();
   for (const Constraint& c : sys.constraints) {
     const bool pick = c.owner == Constraint::Owner::kCut && c.type == Constraint::Type::kPoint &&
-                      std::find(cuts.begin(), cuts.end(), c.owner_name) != cuts.end() &&
-                      (c.bi >= 0 || c.bj >= 0);
+                      picked.count(c.owner_name) && (c.bi >= 0 || c.bj >= 0);
     if (!pick) {
       out.constraints.push_back(c);
       continue;
     }
     Mat3 axes;
     std::array<std::string, 3> names;
-    const Constraint side = frame_side(sys, c, axes, names);
+    const Constraint side = frame_side(sys, dot1, c, axes, names);
     // One dot-2 row per frame axis (a cut's point constraint has all three components).
     for (int k = 0; k < 3; ++k) {
       Constraint r = side;
@@ -186,12 +195,12 @@ EquationChoice choose_independent_equations(const System& sys, const double* q, 
   const RedundancyReport first = find_redundant_constraints(sys, q, t, tolerance);
   // Cuts whose point equations are partly redundant: which components are kept depends on the
   // frame they are written in. (All three redundant: the cut repeats a joint, in any frame.)
+  std::unordered_set<std::string> seen;
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
     if (c.owner != Constraint::Owner::kCut || c.type != Constraint::Type::kPoint) continue;
     if (first.keep[k] == 0 || first.keep[k] == c.mask) continue;
-    if (std::find(out.reexpressed.begin(), out.reexpressed.end(), c.owner_name) == out.reexpressed.end())
-      out.reexpressed.push_back(c.owner_name);
+    if (seen.insert(c.owner_name).second) out.reexpressed.push_back(c.owner_name);
   }
   if (out.reexpressed.empty()) {
     out.system = without_redundant_constraints(sys, first);
