@@ -59,18 +59,31 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
 
 // Redundant constraint equations, found at a configuration that satisfies the constraints
 // (a regularized projection of the guess), then removed (a new System) or reported as an error.
-std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& opt, json& summary) {
+// The choice is one that stays valid as the mechanism moves (choose_independent_equations: a
+// cut's point rows in a frame of its body); summary.json says what was set aside and when.
+std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& opt, json& summary,
+                                                   std::shared_ptr<const System>* all_equations) {
   auto sys = std::make_shared<const System>(build_system(scene.model));
+  if (all_equations) *all_equations = sys;
   describe_system(*sys, summary);
   std::vector<double> qc = sys->q0;
   AugmentedSolver projector(*sys);
   projector.positions(qc.data(), 0.0, 1e-12, 100, 1e-10);
   const bool remove = scene.redundant_constraints != "fail";
-  const RedundancyReport rr = find_redundant_constraints(*sys, qc.data(), 0.0);
+  EquationChoice choice;
+  if (scene.redundant_constraints == "remove_world") {
+    choice.report = find_redundant_constraints(*sys, qc.data(), 0.0);
+    choice.system = without_redundant_constraints(*sys, choice.report);
+  } else {
+    choice = choose_independent_equations(*sys, qc.data(), 0.0);
+  }
+  const RedundancyReport& rr = choice.report;
   summary["redundant_constraints"] = {{"policy", scene.redundant_constraints},
                                       {"equations", rr.equations},
                                       {"rank", rr.rank},
-                                      {"redundant", rr.redundant}};
+                                      {"redundant", rr.redundant},
+                                      {"set_aside", {{{"t", 0.0}, {"equations", rr.redundant}}}},
+                                      {"in_body_frame", choice.reexpressed}};
   if (!rr.redundant.empty()) {
     std::string list;
     for (const auto& r : rr.redundant) list += "\n  " + r;
@@ -80,7 +93,7 @@ std::shared_ptr<const System> build_checked_system(const Scene& scene, const Run
     if (opt.verbose)
       std::fprintf(stderr, "mbdae: removed %zu redundant constraint equations:%s\n", rr.redundant.size(),
                    list.c_str());
-    sys = std::make_shared<const System>(without_redundant_constraints(*sys, rr));
+    sys = std::make_shared<const System>(std::move(choice.system));
   }
   summary["constraint_equations"] = sys->num_constraint_rows();
   return sys;
@@ -211,7 +224,9 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
   summary["scene"] = scene.file;
   summary["model"] = scene.model.name;
   summary["status"] = "running";
-  RunContext c{scene, options, sinks, result, build_checked_system(scene, options, summary), {}, {}};
+  std::shared_ptr<const System> all_equations;
+  RunContext c{scene, options, sinks, result, build_checked_system(scene, options, summary, &all_equations),
+               all_equations, {}, {}};
   c.q = c.system->q0;
   output_columns(c);
   const int last = options.analysis >= 0 ? options.analysis : static_cast<int>(scene.steps.size()) - 1;

@@ -61,7 +61,9 @@ struct Scene {
   Model model;
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
-  std::string redundant_constraints = "remove";  // or "fail"
+  // "remove", "fail", or "remove_world" (the world components chosen at t = 0, the choice before
+  // issue 23, which degrades where a loop's plane turns: for comparison)
+  std::string redundant_constraints = "remove";
   AnimationSpec animation;  // cases/output/animation_spec.h
   // What the scene was read from (null for a scene built in code), for set_parameter.
   std::shared_ptr<const SceneSource> source;

@@ -118,9 +118,10 @@ void scene_options(Loader& l, const YAML::Node& root, Scene& scene, std::vector<
   scene.columns = l.names(root, "output");
   if (root["redundant_constraints"]) {
     scene.redundant_constraints = l.text(root, "redundant_constraints", "remove");
-    if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail")
+    if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail" &&
+        scene.redundant_constraints != "remove_world")
       l.error(root["redundant_constraints"], "redundant_constraints",
-              "expected remove or fail, got '" + scene.redundant_constraints + "'");
+              "expected remove, fail or remove_world, got '" + scene.redundant_constraints + "'");
   }
 }
 
