@@ -190,7 +190,9 @@ def promise_tables(path):
              "velocity sensor (m/s, rad/s), divided by the quantity's scale (the largest |x_ref| of the sensors of "
              "its unit; fast mechanism: of the sensor), the worst sensor named. References: index2-ggl at "
              "rtol 1e-11 (`tolerance_promise`; ref. check: its difference from rtol 1e-10), the fast mechanism's "
-             "Lagrange equation (`fast_mechanism_study`; converged to 1e-10). CPU: `cpu_seconds` of the "
+             "Lagrange equation (`fast_mechanism_study`; converged to 1e-10), the spinning top's Euler equations "
+             "(`verification/studies/promise/`: `promise_study.py`, `spinning_top_reference.py`; its rtol 1e-11 and "
+             "1e-13 solutions agree to 1.6e-11). CPU: `cpu_seconds` of the "
              "integration on a shared machine. Promise: both errors within 10 rtol. Raw data: "
              "`docs/studies/promise.csv`.", "",
              "| case | formulation | rtol | steps | residual evals | CPU [s] | position error / scale | "
