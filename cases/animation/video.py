@@ -107,8 +107,9 @@ def _cells(cell_array):
 
 
 def read_frame(path):
-    """One .vtp frame as numpy arrays: points, force_vector, and per cell section (verts, lines,
-    polys) the point ids and the cell fields, read with vtkXMLPolyDataReader."""
+    """One .vtp frame as numpy arrays: points, force_vector, per cell section (verts, lines,
+    polys) the point ids and the cell fields, and `names`, the field data's string arrays
+    (part_names, body_names, ...), read with vtkXMLPolyDataReader."""
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
 
@@ -120,8 +121,13 @@ def read_frame(path):
     data = reader.GetOutput()
     cd = data.GetCellData()
     fields = {cd.GetArrayName(k): vtk_to_numpy(cd.GetArray(k)) for k in range(cd.GetNumberOfArrays())}
+    fd = data.GetFieldData()
+    names = {}
+    for k in range(fd.GetNumberOfArrays()):  # the names the codes stand for (body_names, ...)
+        a = fd.GetAbstractArray(k)
+        names[a.GetName()] = [a.GetValue(i) for i in range(a.GetNumberOfValues())]
     frame = {"points": vtk_to_numpy(data.GetPoints().GetData()).astype(float),
-             "force_vector": vtk_to_numpy(data.GetPointData().GetArray("force_vector"))}
+             "force_vector": vtk_to_numpy(data.GetPointData().GetArray("force_vector")), "names": names}
     start = 0
     for name, section in (("verts", data.GetVerts()), ("lines", data.GetLines()), ("polys", data.GetPolys())):
         cells = _cells(section)
