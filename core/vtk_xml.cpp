@@ -31,7 +31,40 @@ void VtkPolyData::clear() {
 namespace {
 
 constexpr size_t kBlock = 32768;  // uncompressed bytes per zlib block (VTK's default)
-constexpr int kLevel = 1;         // zlib level: docs/formulation.md ("Hand-written pieces and why")
+// zlib level and hash memory: docs/formulation.md ("Hand-written pieces and why").
+constexpr int kLevel = 1, kMemLevel = 4;
+
+// zlib's worst case for n bytes with any parameters (deflateBound's conservative bound).
+uint64_t deflate_bound(uint64_t n) { return n + (n >> 5) + (n >> 7) + (n >> 11) + 7 + 18; }
+
+}  // namespace
+
+// One zlib stream for every block: compress2() would set up (and clear) a new one per array,
+// which cost as much as the compression itself.
+struct VtkDeflater {
+  z_stream z{};
+  VtkDeflater() {
+    if (deflateInit2(&z, kLevel, Z_DEFLATED, 15, kMemLevel, Z_DEFAULT_STRATEGY) != Z_OK)
+      throw std::runtime_error("zlib cannot start a stream");
+  }
+  ~VtkDeflater() { deflateEnd(&z); }
+  VtkDeflater(const VtkDeflater&) = delete;
+  VtkDeflater& operator=(const VtkDeflater&) = delete;
+  // Compresses n bytes of src as one zlib stream into out; returns its size.
+  size_t pack(const unsigned char* src, size_t n, std::vector<unsigned char>& out) {
+    deflateReset(&z);
+    const size_t bound = deflate_bound(n);
+    if (out.size() < bound) out.resize(bound);
+    z.next_in = const_cast<Bytef*>(src);
+    z.avail_in = static_cast<uInt>(n);
+    z.next_out = out.data();
+    z.avail_out = static_cast<uInt>(bound);
+    if (deflate(&z, Z_FINISH) != Z_STREAM_END) throw std::runtime_error("zlib cannot compress a .vtp array");
+    return bound - z.avail_out;
+  }
+};
+
+namespace {
 
 // A file written under a temporary name and renamed by commit(); removed if not committed.
 class AtomicFile {
@@ -79,12 +112,10 @@ void append_compressed(VtkScratch& s, const void* data, size_t n) {
   const uint64_t first[3] = {blocks, kBlock, n % kBlock};
   std::memcpy(s.appended.data() + head, first, sizeof first);
   const auto* src = static_cast<const unsigned char*>(data);
+  if (blocks > 0 && !s.deflater) s.deflater = std::make_shared<VtkDeflater>();
   for (uint64_t b = 0; b < blocks; ++b) {
     const size_t size = std::min(kBlock, n - b * kBlock);
-    uLongf packed = compressBound(size);
-    if (s.block.size() < packed) s.block.resize(packed);
-    if (compress2(s.block.data(), &packed, src + b * kBlock, size, kLevel) != Z_OK)
-      throw std::runtime_error("zlib cannot compress a .vtp array");
+    const size_t packed = s.deflater->pack(src + b * kBlock, size, s.block);
     const uint64_t p = packed;
     std::memcpy(s.appended.data() + head + 8 * (3 + b), &p, 8);
     s.appended.insert(s.appended.end(), s.block.begin(), s.block.begin() + packed);
@@ -249,7 +280,7 @@ uint64_t vtp_size_bound(const VtkPolyData& d, VtkFormat format) {
   const uint64_t xml = 2048 + 160 * arrays;
   if (format == VtkFormat::kAscii) return xml + 25 * numbers + 4 * strings;
   const uint64_t raw = 8 * numbers + strings;
-  return xml + compressBound(raw) + arrays * (24 + 8 + 64) + 16 * (raw / kBlock + 1);
+  return xml + deflate_bound(raw) + arrays * (24 + 8 + 64) + 40 * (raw / kBlock + 1);
 }
 
 namespace {

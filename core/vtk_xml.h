@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,11 +51,14 @@ struct VtkPolyData {
   void clear();
 };
 
+struct VtkDeflater;  // a zlib stream kept from array to array (vtk_xml.cpp)
+
 // Buffers a writer reuses from file to file (no allocation once they have grown).
 struct VtkScratch {
   std::vector<unsigned char> appended, block, text;
   std::vector<double> gathered;
   std::vector<uint64_t> offsets;
+  std::shared_ptr<VtkDeflater> deflater;
 };
 
 // Writes `data` to `path` (via path.tmp and a rename). Throws std::runtime_error naming the file.
