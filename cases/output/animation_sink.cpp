@@ -480,7 +480,8 @@ long planned_frames(const Scene& scene, const AnimationSpec& spec, bool* by_max_
 
 std::string megabytes(double bytes) {
   char buf[40];
-  if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
+  if (bytes >= 1e12 - 5e8) std::snprintf(buf, sizeof buf, "%.3g TB", bytes / 1e12);
+  else if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
   else if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.3g MB", bytes / 1e6);
   else std::snprintf(buf, sizeof buf, "%.3g kB", bytes / 1e3);
   return buf;
