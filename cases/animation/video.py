@@ -38,7 +38,7 @@ def gif_delays(frames, fps):
     """Frame delays in milliseconds (whole centiseconds, at least 2) for `frames` frames shown
     at `fps` frames per second: each frame's delay rounded so that the time of frame k stays
     within half a centisecond of k / fps (30 fps: 3, 4, 3, 3, 4, 3, ... cs)."""
-    if not 0 < fps <= MAX_FPS["gif"]:
+    if not 0 < fps <= MAX_FPS["gif"]:  # also NaN
         raise ValueError(f"a GIF plays at most {MAX_FPS['gif']} frames per second (its frame delays are "
                          f"hundredths of a second and viewers slow delays under 2 cs), got fps={fps}")
     at = [round(100 * k / fps) for k in range(frames + 1)]
@@ -78,8 +78,8 @@ def frame_plan(times, fps=None, gif=False):
     cap = MAX_FPS["gif" if gif else "mp4"]
     n = len(times)
     if fps is not None:
-        if not fps > 0:
-            raise ValueError(f"fps must be positive, got {fps}")
+        if not (fps > 0 and math.isfinite(fps)):
+            raise ValueError(f"fps must be a positive number, got {fps}")
         if gif and fps > cap:
             gif_delays(1, fps)  # raises the GIF's error
         return list(range(n)), fps

@@ -323,6 +323,9 @@ def test_gif_frame_delays_follow_the_frame_rate(dynamics, tmp_path):
     with pytest.raises(ValueError, match="at most 50 frames per second"):
         video.animate(pvd, str(tmp_path / "c.gif"), fps=60)
     assert video.gif_delays(4, 50) == [20] * 4 and video.gif_delays(3, 7) == [140, 150, 140]
+    for bad in (0, -1, float("nan"), float("inf")):
+        with pytest.raises(ValueError):
+            video.animate(pvd, str(tmp_path / "d.mp4"), fps=bad)
 
 
 def test_interrupted_run_lists_every_frame_it_wrote(tmp_path):
