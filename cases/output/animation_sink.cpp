@@ -319,13 +319,15 @@ bool is_frame_file(const std::string& name) {
 
 // True for a .pvd that mbdae wrote: a collection whose data sets are all animation/frame_*.vtp.
 bool is_our_pvd(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size > (64u << 20)) return false;  // 1e5 frames take 10 MB
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return false;
-  std::string text(1 << 16, '\0');
+  std::string text(size, '\0');
   text.resize(std::fread(text.data(), 1, text.size(), f));
-  const bool whole = std::feof(f) != 0;
   std::fclose(f);
-  if (!whole || text.find("<VTKFile type=\"Collection\"") == std::string::npos) return false;
+  if (text.find("<VTKFile type=\"Collection\"") == std::string::npos) return false;
   for (size_t at = text.find("file=\""); at != std::string::npos; at = text.find("file=\"", at + 1)) {
     const size_t end = text.find('"', at + 6);
     if (end == std::string::npos) return false;
@@ -353,7 +355,7 @@ void remove_animation_files(const std::string& dir) {
   if (!fs::is_directory(folder, ec)) return;
   for (const auto& e : fs::directory_iterator(folder)) {
     const std::string name = e.path().filename().string();
-    if (e.is_regular_file() && (is_frame_file(name) || name == "legend.json" || name == "legend.json.tmp"))
+    if (e.is_regular_file() && (is_frame_file(name) || name == "legend.json" || name == "legend.json.partial"))
       fs::remove(e.path());
   }
   fs::remove(folder, ec);  // only when empty: a folder holding other files stays

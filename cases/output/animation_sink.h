@@ -37,7 +37,8 @@ void check_animation_size(const Scene& scene, const std::string& dir, double fra
 
 // Removes what an earlier run's animation left in `dir`: animation.pvd (when it is mbdae's: a
 // collection of animation/frame_NNNNNN.vtp), animation/frame_NNNNNN.vtp, animation/legend.json,
-// their .tmp files, and animation/ when that leaves it empty. Other files stay.
+// their temporary files (.tmp, .partial), and animation/ when that leaves it empty. Other files
+// stay.
 void remove_animation_files(const std::string& dir);
 
 class AnimationSink : public Sink {

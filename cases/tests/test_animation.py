@@ -282,8 +282,8 @@ def test_animation_larger_than_the_free_space_is_refused_before_the_run(tmp_path
 
 
 def test_a_run_without_animation_removes_the_earlier_runs_frames(tmp_path):
-    out, _ = run(tmp_path, scene_text(0.05), "--animation")
-    assert (out / "animation.pvd").is_file() and list((out / "animation").glob("frame_*.vtp"))
+    out, _ = run(tmp_path, scene_text(0.8), "--animation-rate", "1000")  # a .pvd over 64 kB
+    assert (out / "animation.pvd").stat().st_size > 65536 and list((out / "animation").glob("frame_*.vtp"))
     (out / "animation" / "notes.txt").write_text("mine")  # not mbdae's: stays
     (out / "animation" / "frame_000001.vtp.tmp").write_text("")  # left by a killed run
     run(tmp_path, scene_text(0.05))
