@@ -34,7 +34,8 @@ constexpr size_t kBlock = 32768;  // uncompressed bytes per zlib block (VTK's de
 // zlib level and hash memory: docs/formulation.md ("Hand-written pieces and why").
 constexpr int kLevel = 1, kMemLevel = 4;
 
-// zlib's worst case for n bytes with any parameters (deflateBound's conservative bound).
+// zlib's worst case for n bytes with window bits 15 and memLevel 4 (deflateBound's bound for
+// stored blocks, which it gives when the hash is smaller than the window), with room to spare.
 uint64_t deflate_bound(uint64_t n) { return n + (n >> 5) + (n >> 7) + (n >> 11) + 7 + 18; }
 
 }  // namespace
@@ -53,7 +54,7 @@ struct VtkDeflater {
   // Compresses n bytes of src as one zlib stream into out; returns its size.
   size_t pack(const unsigned char* src, size_t n, std::vector<unsigned char>& out) {
     deflateReset(&z);
-    const size_t bound = deflate_bound(n);
+    const size_t bound = deflateBound(&z, n);
     if (out.size() < bound) out.resize(bound);
     z.next_in = const_cast<Bytef*>(src);
     z.avail_in = static_cast<uInt>(n);

@@ -84,5 +84,41 @@ TEST(PvdAppender, AFailedLineLeavesTheCollectionOfTheEarlierOnes) {
   std::filesystem::remove_all(dir);
 }
 
+// vtp_size_bound bounds the file write_vtp writes, for data zlib cannot compress (random
+// doubles, the longest ASCII numbers) and for data it can.
+TEST(WriteVtp, SizeBoundHoldsForIncompressibleAndCompressibleData) {
+  const std::string dir = temp_dir("bound");
+  uint64_t state = 12345;
+  auto random_double = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return -1.234567890123e-300 * static_cast<double>(state >> 11);
+  };
+  for (int points : {1, 100, 20000}) {
+    for (bool random : {true, false}) {
+      VtkPolyData d;
+      d.point_fields = {VtkField{"v", 3, {}}};
+      d.cell_fields = {"f"};
+      for (VtkCells* c : {&d.verts, &d.lines, &d.polys}) c->fields.assign(1, {});
+      d.field_data = {{"names", {"a", "bb", std::string(300, 'x')}}};
+      for (int k = 0; k < 3 * points; ++k) {
+        d.points.push_back(random ? random_double() : 1.0);
+        d.point_fields[0].values.push_back(random ? random_double() : 0.0);
+      }
+      for (int k = 0; k < points; ++k) {
+        d.verts.connectivity.push_back(k);
+        d.verts.offsets.push_back(k + 1);
+        d.verts.fields[0].push_back(random ? random_double() : 2.0);
+      }
+      for (VtkFormat format : {VtkFormat::kBinary, VtkFormat::kAscii}) {
+        const std::string path = dir + "/f.vtp";
+        write_vtp(path, d, format);
+        EXPECT_LE(std::filesystem::file_size(path), vtp_size_bound(d, format))
+            << points << " points, random " << random << ", ascii " << (format == VtkFormat::kAscii);
+      }
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mbdae
