@@ -496,7 +496,8 @@ double free_bytes(const std::string& dir) {
   std::error_code ec;
   while (!std::filesystem::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
   struct statvfs st;
-  if (::statvfs(p.c_str(), &st) != 0) return -1;
+  // No blocks at all (/proc, /sys): not a place for files; claiming the folder says why.
+  if (::statvfs(p.c_str(), &st) != 0 || st.f_blocks == 0) return -1;
   return static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
 }
 

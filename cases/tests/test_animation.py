@@ -281,6 +281,16 @@ def test_animation_larger_than_the_free_space_is_refused_before_the_run(tmp_path
     assert not (tmp_path / "out").exists()
 
 
+def test_an_unusable_folder_is_the_same_input_error_with_animation(tmp_path):
+    # /proc has no blocks (statvfs: 0 free): the folder check names the folder, exit 2, as without.
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(scene_text(0.05))
+    for args in ([], ["--animation"]):
+        p = subprocess.run([MBDAE, "run", str(scene), "--out", "/proc/mbdae_x", "--quiet", *args],
+                           capture_output=True, text=True)
+        assert p.returncode == 2 and "field '--out'" in p.stderr and "cannot be created" in p.stderr, p.stderr
+
+
 def test_a_run_without_animation_removes_the_earlier_runs_frames(tmp_path):
     out, _ = run(tmp_path, scene_text(0.8), "--animation-rate", "1000")  # a .pvd over 64 kB
     assert (out / "animation.pvd").stat().st_size > 65536 and list((out / "animation").glob("frame_*.vtp"))
