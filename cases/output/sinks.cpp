@@ -15,8 +15,14 @@ void SummarySink::end(const Result& result) { write_json_file(path_, result.summ
 
 RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
   RunSinks s;
+  if (!request.out_dir.empty()) s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
+  renew_sinks(scene, request, s);
+  return s;
+}
+
+void renew_sinks(const Scene& scene, const OutputRequest& request, RunSinks& s) {
+  s.list.clear();
   if (!request.out_dir.empty()) {
-    s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
     s.csv = std::make_unique<CsvSink>(request.out_dir + "/results.csv");
     s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
     s.list = {s.csv.get(), s.summary.get()};
@@ -26,7 +32,6 @@ RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
     s.animation = std::make_unique<AnimationSink>(scene, request.animation_dir, request.animation_rate);
     s.list.push_back(s.animation.get());
   }
-  return s;
 }
 
 }  // namespace mbdae
