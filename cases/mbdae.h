@@ -55,6 +55,7 @@ struct RunOptions {
   int analysis = -1;          // >= 0: run the steps up to and including this one only
   bool verbose = false;       // print assembly / equilibrium results on stdout
   bool progress = false;      // progress line on stderr for runs over a second
+  bool report_failures = true;  // a failure's message on stderr (off for the error estimate's own runs)
   // Set from another thread (or a signal handler) to stop at the next step; the run then ends
   // with status "interrupted" and keeps what it computed.
   const std::atomic<bool>* stop = nullptr;

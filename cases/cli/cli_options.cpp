@@ -47,7 +47,24 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
     return "--formulation: expected one of " + list + ", got '" + opt.formulation + "'";
   }
   if (a == "--error-estimate") {
-    cl.error_estimate = true;
+    cl.error.estimate = true;
+    return "";
+  }
+  if (a == "--error-target" && has_value) {
+    const std::string why = read_number(a, args[++i], cl.error.target);
+    if (!why.empty() || cl.error.target > 0) return why;
+    return a + ": must be a positive error in the sensors' units, got '" + args[i] + "'";
+  }
+  if (a == "--error-sensors" && has_value) {
+    const std::string& list = args[++i];
+    size_t start = 0;
+    while (start <= list.size()) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      const std::string name = list.substr(start, comma - start);
+      if (name.empty()) return a + ": expected sensor names separated by commas, got '" + list + "'";
+      cl.error.sensors.push_back(name);
+      start = comma + 1;
+    }
     return "";
   }
   if (a == "--animation") {
@@ -75,6 +92,7 @@ void print_usage() {
   for (const std::string& f : formulations()) names += (names.empty() ? "" : "|") + f;
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
+               "                  [--error-target E] [--error-sensors a,b]\n"
                "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation %s]\n"
                "       mbdae check SCENE.yaml\n"
@@ -104,11 +122,13 @@ std::string parse_command_line(const std::vector<std::string>& args, CommandLine
     if (!why.empty()) return why;
   }
   if (!cl.check_only && !cl.list_params && cl.out_dir.empty()) return "--out DIR is required";
+  if (!cl.error.sensors.empty() && !(cl.error.target > 0)) return "--error-sensors: needs --error-target E";
   return "";
 }
 
-std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& opt) {
-  std::vector<std::string> out;
+std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl) {
+  const RunOptions& opt = cl.options;
+  std::vector<std::string> out = check_error_sensors(scene, cl.error.sensors, "--error-sensors");
   if (!(opt.output_step > 0)) return out;
   for (const AnalysisStep& s : scene.steps) {
     if (!integrates(s)) continue;

@@ -1,5 +1,6 @@
 // The command line of mbdae (cases/cli/main.cpp):
 //   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT] [--quiet] [--error-estimate]
+//                         [--error-target E] [--error-sensors a,b]
 //                         [--formulation index3|index2-ggl|index1|penalty]
 //                         [--animation] [--animation-rate HZ]
 //   mbdae check SCENE.yaml
@@ -13,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "cases/run/error_target.h"
 #include "cases/mbdae.h"
 
 namespace mbdae {
@@ -25,15 +27,15 @@ struct CommandLine {
   std::string out_dir;  // --out: results.csv and summary.json go there
   RunOptions options;
   bool show_usage = false;  // after an error: the usage text helps
-  bool error_estimate = false;  // --error-estimate (cases/run/error_estimate.h)
+  ErrorControl error;  // --error-estimate, --error-target, --error-sensors (cases/run/error_target.h)
   bool animation = false;     // --animation: DIR/animation.pvd (cases/output/animation_sink.h)
   double animation_rate = 0;  // --animation-rate HZ (implies --animation)
 };
 
 // Reads the arguments after the program name; returns "" or the usage error (exit code 1).
 std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl);
-// The command-line overrides checked against the scene's integration steps; empty if fine.
-std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& options);
+// The command-line overrides checked against the scene's integration steps and sensors; empty if fine.
+std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl);
 void print_usage();
 
 }  // namespace mbdae

@@ -14,7 +14,7 @@
 
 #include "cases/output/animation_sink.h"
 #include "cases/cli/cli_options.h"
-#include "cases/run/error_estimate.h"
+#include "cases/run/error_target.h"
 #include "cases/mbdae.h"
 #include "cases/output/sinks.h"
 #include "cases/run/signals.h"
@@ -60,15 +60,19 @@ int main(int argc, char** argv) {
                   sys.num_bodies(), sys.nq(), sys.num_constraint_rows());
       return 0;
     }
-    const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, opt);
+    const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, cl);
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
     const bool animate = cl.animation || scene.animation.write;  // DIR/animation.pvd
-    mbdae::RunSinks out = mbdae::open_sinks(scene, {cl.out_dir, animate ? cl.out_dir : "", cl.animation_rate});
-    const std::vector<mbdae::Sink*>& sinks = out.list;
-    const bool estimate = cl.error_estimate || mbdae::error_estimate_requested(scene);
-    const mbdae::Result r = estimate ? mbdae::run_with_error_estimate(scene, opt, sinks, cl.out_dir + "/summary.json")
-                                     : mbdae::run(scene, opt, sinks);  // load, run, write
+    const mbdae::OutputRequest request{cl.out_dir, animate ? cl.out_dir : "", cl.animation_rate};
+    mbdae::RunSinks out = mbdae::open_sinks(scene, request);
+    int tries = 0;  // an error target's later tries get fresh writers (cases/run/error_target.h)
+    const mbdae::SinkFactory make_sinks = [&] {
+      if (tries++ > 0) mbdae::renew_sinks(scene, request, out);
+      return out.list;
+    };
+    const mbdae::Result r = mbdae::run_controlled(scene, opt, mbdae::error_control(scene, cl.error), make_sinks,
+                                                  cl.out_dir + "/summary.json");  // load, run, write
     const bool interrupted = r.status == "interrupted";
     return interrupted && mbdae::stop_signal() ? 128 + mbdae::stop_signal() : r.exit_code;
   } catch (const mbdae::SceneError& e) {

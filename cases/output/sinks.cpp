@@ -22,6 +22,14 @@ RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
     s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
     // An earlier run's animation files, when this run writes none there.
     if (request.animation_dir != request.out_dir) remove_animation_files(request.out_dir);
+  }
+  renew_sinks(scene, request, s);
+  return s;
+}
+
+void renew_sinks(const Scene& scene, const OutputRequest& request, RunSinks& s) {
+  s.list.clear();
+  if (!request.out_dir.empty()) {
     s.csv = std::make_unique<CsvSink>(request.out_dir + "/results.csv");
     s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
     s.list = {s.csv.get(), s.summary.get()};
@@ -31,7 +39,6 @@ RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
     s.animation = std::make_unique<AnimationSink>(scene, request.animation_dir, request.animation_rate);
     s.list.push_back(s.animation.get());
   }
-  return s;
 }
 
 }  // namespace mbdae

@@ -58,5 +58,8 @@ struct RunSinks {
 // Claims the output folder (claim_output_folder: lock, previous summary.json removed) and makes
 // the sinks of `request`. Throws OutputError when the folder is in use or cannot be written.
 RunSinks open_sinks(const Scene& scene, const OutputRequest& request);
+// Fresh writers for another run into the same folder (the tries of an error target,
+// cases/run/error_target.h), keeping the lock of `sinks`.
+void renew_sinks(const Scene& scene, const OutputRequest& request, RunSinks& sinks);
 
 }  // namespace mbdae

@@ -15,6 +15,7 @@
 
 #include "cases/scene/analysis_types.h"
 #include "cases/output/animation_sink.h"
+#include "cases/run/error_target.h"
 #include "cases/mbdae.h"
 #include "cases/output/sinks.h"
 #include "core/output.h"
@@ -30,13 +31,22 @@ namespace {
 struct PyRunOptions : mbdae::RunOptions {
   std::string out_dir, animation_dir;
   double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
+  mbdae::ErrorControl error;  // run(error_estimate=, error_target=, error_sensors=) (cases/run/error_target.h)
 };
 
 // mbdae::run with the CLI's sinks (open_sinks, cases/output/sinks.h: the same folder lock) when an
-// output folder is given, and the animation sink.
+// output folder is given, and the animation sink; with an error estimate or target as asked
+// (fresh writers for every try of a target).
 mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
-  mbdae::RunSinks out = mbdae::open_sinks(scene, {options.out_dir, options.animation_dir, options.animation_rate});
-  return mbdae::run(scene, options, out.list);
+  const mbdae::OutputRequest request{options.out_dir, options.animation_dir, options.animation_rate};
+  mbdae::RunSinks out = mbdae::open_sinks(scene, request);
+  int tries = 0;
+  const mbdae::SinkFactory make_sinks = [&] {
+    if (tries++ > 0) mbdae::renew_sinks(scene, request, out);
+    return out.list;
+  };
+  return mbdae::run_controlled(scene, options, mbdae::error_control(scene, options.error), make_sinks,
+                               options.out_dir.empty() ? "" : options.out_dir + "/summary.json");
 }
 
 // A column of a Result as a read-only numpy array over the Result's own memory (no copy): the
@@ -127,7 +137,18 @@ void bind_run(py::module_& m) {
       .def_readwrite("progress", &mbdae::RunOptions::progress)
       .def_readwrite("out_dir", &PyRunOptions::out_dir)
       .def_readwrite("animation_dir", &PyRunOptions::animation_dir)
-      .def_readwrite("animation_rate", &PyRunOptions::animation_rate);
+      .def_readwrite("animation_rate", &PyRunOptions::animation_rate)
+      .def_property("error_estimate", [](const PyRunOptions& o) { return o.error.estimate; },
+                    [](PyRunOptions& o, bool v) { o.error.estimate = v; })
+      .def_property("error_target", [](const PyRunOptions& o) { return o.error.target; },
+                    [](PyRunOptions& o, double v) { o.error.target = v; })
+      .def_property("error_warnings", [](const PyRunOptions& o) { return o.error.warnings; },
+                    [](PyRunOptions& o, bool v) { o.error.warnings = v; })
+      .def_property("error_sensors", [](const PyRunOptions& o) { return o.error.sensors; },
+                    [](PyRunOptions& o, std::vector<std::string> v) { o.error.sensors = std::move(v); });
+  m.def("check_error_sensors", [](const mbdae::Scene& s, const std::vector<std::string>& names) {
+    return mbdae::check_error_sensors(s, names, "error_sensors");
+  });
   py::class_<mbdae::Result, std::shared_ptr<mbdae::Result>>(m, "Result")
       .def_readonly("status", &mbdae::Result::status)
       .def_readonly("message", &mbdae::Result::message)

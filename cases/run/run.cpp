@@ -160,7 +160,8 @@ void fail(RunContext& c, const std::string& status, const std::string& message, 
   c.result.message = message;
   c.result.exit_code = 3;
   c.result.q = c.q;
-  std::fprintf(stderr, "mbdae: %s\n", message.c_str());  // also under --quiet: a failure is always said
+  if (c.options.report_failures)  // also under --quiet: a failure is always said
+    std::fprintf(stderr, "mbdae: %s\n", message.c_str());
 }
 
 void output_failed(RunContext& c, const std::string& message) {

@@ -143,6 +143,14 @@ AnalysisStep Loader::step(const YAML::Node& n) {
   step_span_and_tolerances(n, integrates, s);
   flag(n, "output_projection", s.output_projection);
   flag(n, "error_estimate", s.error_estimate);
+  // The error target (cases/run/error_target.h): a positive error, and the sensors it is for.
+  const auto target = opt_number(n, "error_target");
+  if (target && !(*target > 0 && std::isfinite(*target)))
+    error(n["error_target"], "error_target", "must be a positive error in the sensors' units, got " + format_number(*target));
+  else if (target) s.error_target = *target;
+  s.error_sensors = names(n, "error_sensors");
+  if (!s.error_sensors.empty() && !target)
+    error(n["error_sensors"], "error_target", "missing (error_sensors name the sensors of error_target)");
   step_formulation(n, s);
   step_checks(n, integrates, s);
   return s;

@@ -22,7 +22,11 @@ struct AnalysisStep {
   // (formulation/tolerance_scales.h).
   double rtol = 1e-6, atol = 0, max_step = 0;
   double length_scale = 0, time_scale = 0, atol_rotation = 0, atol_velocity = 0;
-  bool error_estimate = false;  // repeat the run at rtol / 100 to estimate its error (cases/run/error_estimate.h)
+  bool error_estimate = false;  // estimate the run's global error (cases/run/error_estimate.h)
+  // > 0: pick rtol and atol so that the estimated global error of error_sensors (default every
+  // output sensor, error_target then relative to each one's scale) is at most this (cases/run/error_target.h).
+  double error_target = 0;
+  std::vector<std::string> error_sensors;
   double constraint_scale = 0;  // 0: automatic
   double newton_convergence = 0.33;  // IDA's Newton convergence coefficient (epcon)
   // "reduced": Newton solves with the velocity corrections eliminated through q' - v (index3

@@ -1,4 +1,4 @@
-"""The shell form of mbdae.sweep:
+"""The shell forms of mbdae.sweep and mbdae.work_precision:
 
     python3 -m mbdae sweep SCENE --param forces.suspension.damping=700:2800:8 \\
         --param forces.tyre.stiffness=1e5,2e5,4e5 --out DIR [--workers N] [--processes]
@@ -10,7 +10,15 @@ several --param make a grid. --set PATH=VALUE overrides every run; --metric NAME
 adds a table column (mbdae.metrics.from_spec). Runs go to threads of this process (--workers N,
 default one per core), to a local cluster of processes (--processes) or to a Dask scheduler.
 Exit codes: 0 every run ok, 1 bad command line (option, metric), 2 bad scene or parameter path,
-3 some run not ok, 4 the folder cannot be written or is in use by another sweep or run."""
+3 some run not ok, 4 the folder cannot be written or is in use by another sweep or run.
+
+    python3 -m mbdae work-precision SCENE [--out DIR] [--formulations index3,index1]
+        [--tols 1e-2,1e-4,...] [--columns wheel_z,wheel_vz] [--reference REF.csv] [--estimate]
+        [--atol-ratio R] [--workers N]
+
+runs every formulation at every rtol (default 1e-2 to 1e-10), measures each output column's error
+against a reference (a tight run of another formulation, or REF.csv), prints each curve's slope and
+floor and writes DIR/work_precision.csv and DIR/work_precision_COLUMN.png (docs/python.md)."""
 import argparse
 import sys
 
@@ -75,9 +83,73 @@ class _Parser(argparse.ArgumentParser):
         self.exit(1, f"{self.prog}: error: {message}\n")
 
 
+def _list(text, what, convert=str):
+    items = [x.strip() for x in text.split(",")]
+    if not all(items):
+        raise ValueError(f"{what}: expected a comma-separated list, got '{text}'")
+    try:
+        return [convert(x) for x in items]
+    except ValueError:
+        raise ValueError(f"{what}: expected numbers, got '{text}'") from None
+
+
+def _work_precision(a):
+    import math
+
+    import mbdae
+    from mbdae.work_precision import report
+    try:
+        scene = mbdae.load(a.scene)
+    except mbdae.SceneError as e:
+        print(e, file=sys.stderr)
+        return 2
+    try:
+        forms = _list(a.formulations, "--formulations") if a.formulations else None
+        unknown = [f for f in forms or [] if f not in mbdae.formulations()]
+        if unknown:
+            raise ValueError(f"--formulations: unknown {', '.join(unknown)} (expected {', '.join(mbdae.formulations())})")
+        tols = _list(a.tols, "--tols", float) if a.tols else None
+        if tols and not all(1e-14 <= t <= 0.5 for t in tols):
+            raise ValueError(f"--tols: every rtol must be in [1e-14, 0.5], got '{a.tols}'")
+        columns = _list(a.columns, "--columns") if a.columns else None
+        if a.atol_ratio is not None and not (a.atol_ratio > 0 and math.isfinite(a.atol_ratio)):
+            raise ValueError(f"--atol-ratio: must be a positive number, got {a.atol_ratio}")
+        if a.workers is not None and a.workers < 1:
+            raise ValueError(f"--workers: must be at least 1, got {a.workers}")
+        if columns:
+            known = mbdae._core.check_error_sensors(scene._core, columns)
+            if known:
+                raise ValueError("; ".join(k.replace("error_sensors", "--columns") for k in known))
+        table, curves, notes = report(scene, a.out, forms, tols, columns, reference_csv=a.reference,
+                                         estimate=a.estimate, atol_ratio=a.atol_ratio, workers=a.workers,
+                                         progress=not a.no_progress)
+    except (ValueError, FileNotFoundError, KeyError) as e:
+        print(f"mbdae work-precision: {e}", file=sys.stderr)
+        return 1
+    for n in notes:
+        print(n)
+    print(f"{'formulation':12s} {'column':12s} {'runs':>4s} {'slope':>6s} {'min error':>10s}  floor from rtol")
+    for c in curves:
+        floor = "none (keeps falling)" if c["floor_from_rtol"] is None else f"{c['floor_from_rtol']:g}"
+        print(f"{c['formulation']:12s} {c['column']:12s} {c['runs']:4d} {c['slope']:6.2f} {c['min_error']:10.3g}  {floor}")
+    print(f"table {a.out}/work_precision.csv, figures {a.out}/work_precision_*.png")
+    return 0 if (table["status"] == "ok").all() else 3
+
+
 def main(argv=None):
     ap = _Parser(prog="python3 -m mbdae", description="mbdae parameter sweeps (threads, or Dask)")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    wpp = sub.add_parser("work-precision", help="error against CPU time and rtol, every formulation")
+    wpp.add_argument("scene")
+    wpp.add_argument("--out", default="work_precision")
+    wpp.add_argument("--formulations", help="comma-separated (default: every formulation)")
+    wpp.add_argument("--tols", help="comma-separated rtols (default 1e-2,1e-3,...,1e-10)")
+    wpp.add_argument("--columns", help="comma-separated output sensors (default: all)")
+    wpp.add_argument("--reference", help="a CSV with t and the columns (default: a tight index2-ggl run)")
+    wpp.add_argument("--estimate", action="store_true", help="also each run's --error-estimate (est_COLUMN)")
+    wpp.add_argument("--atol-ratio", type=float, help="atol = R rtol (default: the scene's rule)")
+    wpp.add_argument("--workers", type=int, help="Dask worker processes (default: runs one after the other)")
+    wpp.add_argument("--no-progress", action="store_true")
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameters")
     sw.add_argument("scene")
     sw.add_argument("--param", action="append", default=[], metavar="PATH=A:B:N|V1,V2,...")
@@ -97,6 +169,8 @@ def main(argv=None):
     pa = sub.add_parser("params", help="list a scene's parameter paths with values and units")
     pa.add_argument("scene")
     a = ap.parse_args(argv)
+    if a.command == "work-precision":
+        return _work_precision(a)
     if a.command == "params":
         return _params_command(a)
     if a.scheduler and (a.processes or a.workers):

@@ -116,14 +116,20 @@ class Scene:
         return opt
 
     def run(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, out=None,
-            raise_on_failure=True, animation=None, animation_rate=None):
+            raise_on_failure=True, animation=None, animation_rate=None, error_estimate=None, error_target=None,
+            error_sensors=None, error_warnings=True):
         """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
         override the scene's when given; `analysis` (an index or a step type such as "dynamics")
         stops after that step; `out` also writes results.csv and summary.json there. `animation`
         (a folder, or True for `out` or a new temporary folder, removed with the Result or at
         exit) also writes the run as a ParaView time series (animation.pvd, docs/animation.md)
         that Result.animation() draws as a video;
-        `animation_rate` sets its frames per second of simulated time. Returns a Result; a failed
+        `animation_rate` sets its frames per second of simulated time. `error_estimate=True` adds
+        the global error estimate (summary["error_estimate"], docs/formulation.md);
+        `error_target=E` picks rtol and atol so that the estimated error of `error_sensors` (a list
+        of names; default every output sensor, E then relative to each one's scale) is at most E
+        (summary["error_target"]; status "accuracy_not_met" when it cannot); error_warnings=False
+        keeps the estimate's warnings (over 10 rtol) off stderr. Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis)
@@ -138,6 +144,10 @@ class Scene:
         try:
             if animation_rate is not None:
                 opt.animation_rate = _positive("animation_rate", animation_rate)
+            self._error_options(opt, error_estimate, error_target, error_sensors)
+            if not isinstance(error_warnings, bool):
+                raise ValueError(f"error_warnings expects True or False, got {error_warnings!r}")
+            opt.error_warnings = error_warnings
             result = Result._from_core(_scene_errors(_core.run, self._core, opt))
         except BaseException:
             if temporary:
@@ -151,6 +161,26 @@ class Scene:
         if raise_on_failure and not result.ok:
             raise SolveError(result)
         return result
+
+    def _error_options(self, opt, error_estimate, error_target, error_sensors):
+        if error_estimate is not None:
+            if not isinstance(error_estimate, bool):
+                raise ValueError(f"error_estimate expects True or False, got {error_estimate!r}")
+            opt.error_estimate = error_estimate
+        if error_target is not None:
+            opt.error_target = _positive("error_target", error_target)
+        if error_sensors is not None:
+            if isinstance(error_sensors, str):
+                error_sensors = [error_sensors]
+            names = list(error_sensors)
+            if not names or not all(isinstance(n, str) and n for n in names):
+                raise ValueError(f"error_sensors expects a list of sensor names, got {error_sensors!r}")
+            if error_target is None:
+                raise ValueError("error_sensors needs error_target")
+            bad = _core.check_error_sensors(self._core, names)
+            if bad:
+                raise ValueError("; ".join(bad))
+            opt.error_sensors = names
 
     def _analysis_index(self, analysis):
         types = self._core.step_types
@@ -207,7 +237,7 @@ def _rebuild(path, text, overrides):
 
 def _positive(name, value, upper=math.inf):
     v = float(value)
-    if not (v > 0) or v > upper:
+    if not (v > 0) or v > upper or math.isinf(v):
         raise ValueError(f"{name} expects a number in (0, {upper:g}], got {value!r}")
     return v
 
