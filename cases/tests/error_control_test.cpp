@@ -99,10 +99,11 @@ TEST(ErrorControlScene, FieldsAreChecked) {
   EXPECT_EQ(c.sensors, std::vector<std::string>{"wheel_z"});
 }
 
-// index2-ggl misses the promise on the fast mechanism at rtol 1e-6 (500 to 850 rtol): the summary
-// keeps error, scale, relative and exceeded per sensor, and stderr warns.
+// index3-positions (local errors per step) misses the promise on the fast mechanism at rtol 1e-6
+// (1.5e4 to 2.6e4 rtol; index2-ggl keeps it since issue 21's error per unit of the span): the
+// summary keeps error, scale, relative and exceeded per sensor, and stderr warns.
 TEST_F(ErrorControlCli, EstimateReportsAndWarns) {
-  const auto r = mbdae_run(kFast, "--formulation index2-ggl --error-estimate");
+  const auto r = mbdae_run(kFast, "--formulation index3-positions --error-estimate");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("mbdae: warning: sensor pin_y: estimated global error"), std::string::npos) << r.output;
   const auto s = nlohmann::json::parse(read_file(out / "summary.json"));

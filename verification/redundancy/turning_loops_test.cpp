@@ -65,13 +65,17 @@ TEST_P(TurningLoop, RunsToTheEndWithTheRightMotion) {
   const TurningErrors e = turning_errors(c, r);
   std::printf("%s %s, rtol %g: largest error / scale %.3g (%.3g rtol)\n", c.scene, formulation.c_str(), rtol, e.worst,
               e.worst / rtol);
-  if (formulation == "index3") {
+  // Every formulation with an error control that promises 10 rtol keeps it (since issue 21:
+  // index2-ggl, index1 and penalty per unit of the run's span; measured 0.24 to 8.7 rtol, penalty's
+  // 8.7 on the four-bar being its constraint bias).
+  if (formulation != "index3-positions") {
     for (size_t k = 0; k < e.sensors.size(); ++k)
       EXPECT_LE(e.error[k], 10 * rtol * e.scale[k])
           << formulation << ": " << e.sensors[k] << " error " << e.error[k] << " on a scale of " << e.scale[k];
     return;
   }
-  // Converging: 1000 times tighter, at least 30 times closer (measured 100 to 2000 times).
+  // index3-positions tests local errors per step (no promise): converging, 1000 times tighter at
+  // least 30 times closer (measured 165 to 360 times).
   const Result tight = run_case(c, formulation, rtol / 1000);
   expect_complete(c, tight);
   if (HasFatalFailure()) return;
