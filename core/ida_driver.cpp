@@ -34,6 +34,7 @@ struct UserData {
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
   std::string callback_error;  // an exception of the problem's residual or Jacobian
+  std::string callback_status;  // a SolveError's status (a load that is not finite), else empty
   int non_finite = -1;         // a component of y found not finite by weights_fn
   double non_finite_value = 0;
 };
@@ -69,11 +70,20 @@ int callback_failed(UserData* u, const char* where, const std::exception& e) {
   u->callback_error = std::string(where) + ": " + e.what();
   return -1;
 }
+// A SolveError of the problem (a load that is not finite, formulation/sensors.cpp) ends the run
+// with its own status and message.
+int callback_solve_error(UserData* u, const SolveError& e) {
+  u->callback_status = e.status;
+  u->callback_error = e.what();
+  return -1;
+}
 
 int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
   auto* u = static_cast<UserData*>(ud);
   try {
     return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r));
+  } catch (const SolveError& e) {
+    return callback_solve_error(u, e);
   } catch (const std::exception& e) {
     return callback_failed(u, "residual", e);
   }
@@ -91,6 +101,8 @@ int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector
   try {
     return u->problem->jacobian(t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                                 SUNSparseMatrix_Data(jac));
+  } catch (const SolveError& e) {
+    return callback_solve_error(u, e);
   } catch (const std::exception& e) {
     return callback_failed(u, "Jacobian", e);
   }
@@ -172,6 +184,8 @@ struct IdaRun {
   double t = 0, t_prev = 0;  // the current time and that of the last accepted step
   std::vector<double> y_prev, yp_prev;
   IdaStats stats;
+  long watch_steps = 0;  // steps since watch_t (the stall watch, IdaOptions::stall_steps)
+  double watch_t = 0;
 
   IdaRun() = default;
   IdaRun(const IdaRun&) = delete;
@@ -299,6 +313,7 @@ void ida_failure(IdaRun& r, int flag) {
         non_finite_error(r.problem->component_name(i) + " (y[" + std::to_string(i) + "])", r.ud.non_finite_value, tt);
     return fail(r, e.status, e.what(), tt);
   }
+  if (!r.ud.callback_status.empty()) return fail(r, r.ud.callback_status, r.ud.callback_error, tt);
   if (!r.ud.callback_error.empty())
     return fail(r, "internal_error", "the DAE's " + r.ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
   std::ostringstream os;
@@ -471,6 +486,31 @@ bool advance(IdaRun& r) {
   return restart(r, is_root ? r.roots.data() : nullptr);
 }
 
+// The stall watch: a run whose last stall_steps steps advanced t by less than stall_fraction of
+// its span would need more than stall_steps / stall_fraction steps to finish (a load or a motion
+// growing without bound, such as a torque exp(1000 t), makes the step collapse and never ends).
+bool stalled(IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  if (o.stall_steps <= 0 || ++r.watch_steps < o.stall_steps) return false;
+  const double advanced = r.t - r.watch_t, span = o.t1 - o.t0;
+  if (advanced >= o.stall_fraction * span) {
+    r.watch_steps = 0;
+    r.watch_t = r.t;
+    return false;
+  }
+  double h = 0;
+  IDAGetCurrentStep(r.mem, &h);
+  std::ostringstream os;
+  os.precision(6);
+  os << "the integration stalled: " << o.stall_steps << " steps advanced t by only " << advanced << " s (from "
+     << r.watch_t << " to " << r.t << "), less than " << o.stall_fraction << " of the run's span [" << o.t0 << ", "
+     << o.t1 << "], with step size " << h << " s at the end: at this rate the run would need more than "
+     << static_cast<double>(o.stall_steps) / o.stall_fraction
+     << " steps (a load or a motion growing without bound? docs/errors.md, 'stalled')";
+  fail(r, "integration_stalled", os.str(), r.t);
+  return true;
+}
+
 }  // namespace
 
 IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>& y0, std::vector<double>& yp0,
@@ -486,10 +526,11 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   r.sample_index = 1;
   check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
   problem.set_segment(r.t, segment_end(r));
+  r.watch_t = o.t0;
   while (!r.stop_requested && r.stats.ok && r.t < o.t1) {
     if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
     try {
-      if (!advance(r)) break;
+      if (!advance(r) || stalled(r)) break;
     } catch (const SolveError& e) {  // a SUNDIALS call that failed (check)
       fail(r, e.status, e.what(), r.t);
       break;

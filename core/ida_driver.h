@@ -24,7 +24,14 @@ struct IdaOptions {
   double max_step = 0;        // 0: no limit
   double initial_step = 0;    // 0: IDA's own choice
   int max_order = 5;
-  long max_steps = 2000000;
+  long max_steps = 2000000;   // per call of IDASolve (one step each here: no limit on the run)
+  // The stall watch: the run fails (status "integration_stalled") when stall_steps consecutive
+  // steps advance t by less than stall_fraction of [t0, t1], i.e. when finishing would take more
+  // than stall_steps / stall_fraction (1e9) steps; 0 turns it off. The longest run measured so far
+  // took 1.0e7 steps over 1000 s (docs/extreme-cases.md): about 23 steps per cycle at 900 Hz at its
+  // end, so 1e5 steps covered about 5 s there, 5e-3 of its span.
+  long stall_steps = 100000;
+  double stall_fraction = 1e-4;
   double nonlinear_convergence = 0.33;  // IDA's epcon
   double delta_cj = 0.01;               // relative change of cj that forces a new Newton matrix
   const std::atomic<bool>* stop = nullptr;  // set (from a signal handler) to stop after the next step
