@@ -160,6 +160,9 @@ void add_forces(const ModelIndex& index, System& sys, const NameIndex& coordinat
     f.axis = b1->local_vector(fs.axis.normalized());
     if (fs.type == ForceSpec::Type::kWheelContact && f.bi < 0)
       fail(fs.where, "body1", "wheel contact on a body merged into ground");
+    if ((fs.type == ForceSpec::Type::kTorque || fs.type == ForceSpec::Type::kPointForce) && f.bi < 0)
+      fail(fs.where, "body", std::string(fs.type == ForceSpec::Type::kTorque ? "torque" : "point force") + " '" +
+                                 fs.name + "' on ground (or a body fixed to it) does nothing");
     add_load_fields(fs, sys, coordinate_of, f);
     if (fs.type == ForceSpec::Type::kUser) {
       f.law = find_force_law(fs.law);
