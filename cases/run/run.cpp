@@ -50,6 +50,8 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     }
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
+    case T::kAngularVelocity: return "rad/s";
+    case T::kAngularMomentum: return "N m s";
     case T::kExpression: return "";
   }
   return "";
@@ -190,6 +192,11 @@ bool run_step(RunContext& c, const AnalysisStep& step) {
 }
 
 }  // namespace
+
+void check_runnable(const Scene& scene, const RunOptions& options) {
+  json summary;
+  build_checked_system(scene, options, summary);
+}
 
 Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks) {
   Result result;
