@@ -195,7 +195,9 @@ bool run_step(RunContext& c, const AnalysisStep& step) {
 
 void check_runnable(const Scene& scene, const RunOptions& options) {
   json summary;
-  build_checked_system(scene, options, summary);
+  RunOptions quiet = options;  // run() reports what it removes
+  quiet.verbose = false;
+  build_checked_system(scene, quiet, summary);
 }
 
 Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks) {
