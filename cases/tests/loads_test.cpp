@@ -307,7 +307,7 @@ TEST(Loads, LoadExpressionErrorsNameTheField) {
   std::string e = errors_of(wheel("  - {name: motor, type: torque, body: wheel, axis: [0, 0, 1], torque: \"T0 * speed\", "
                                   "parameters: {T0: 1}}\n",
                                   "", analysis(1)));
-  EXPECT_NE(e.find("field 'torque': unknown name 'speed'"), std::string::npos) << e;
+  EXPECT_NE(e.find("field 'torque': force 'motor': unknown name 'speed'"), std::string::npos) << e;
   e = errors_of(wheel("  - {name: motor, type: torque, body: wheel, axis: [0, 0, 1], torque: 1, parameters: {t: 1}}\n", "",
                       analysis(1)));
   EXPECT_NE(e.find("field 'parameters.t': 't' is reserved in expressions"), std::string::npos) << e;
