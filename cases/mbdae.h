@@ -39,6 +39,13 @@ struct System;  // formulation/system.h: the mechanism in absolute coordinates
 void set_parameter(Scene& scene, const std::string& path, const std::string& yaml_value);
 // A copy of `scene` with every (path, value) override applied in order.
 Scene with_parameters(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides);
+// Every parameter path of `scene` (and its model file) with its value and SI unit, from the
+// resolver set_parameter uses (what `mbdae params SCENE` prints). List elements are paths too:
+// bodies.chassis.points.bp1.2 is the z of point bp1.
+std::vector<ParameterEntry> parameters(const Scene& scene);
+// The columns a run of `scene` writes ("t", then the output sensors) with their SI units,
+// without running it (the model is built; ModelError as in run()).
+std::vector<std::pair<std::string, std::string>> output_columns(const Scene& scene);
 
 // ---- Running --------------------------------------------------------------------------------
 struct RunOptions {

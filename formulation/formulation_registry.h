@@ -1,13 +1,15 @@
-// The formulations a run can integrate with: name, factory and defaults. The table is built
-// once and never changed (safe from any thread). A new formulation is its own file (a class
-// derived from MultibodyDae) plus one entry in formulation_registry.cpp; the scene loader, the
-// command line and the run find it here.
+// The formulations a run can integrate with: name, factory, defaults and the time integrator
+// that advances it. The table is built once and never changed (safe from any thread). A new
+// formulation is its own file (a class derived from MultibodyDae) plus one entry in
+// formulation_registry.cpp; the scene loader, the command line and the run find it here.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/ida_driver.h"
 #include "formulation/multibody_dae.h"
 
 namespace mbdae {
@@ -20,6 +22,14 @@ struct FormulationParameters {
   double penalty = 1e7;  // p = penalty * largest body mass (penalty)
 };
 
+// A time integrator: advances `problem` from options.t0 to options.t1, handing each sample to
+// `output` (core/ida_driver.h's integrate, SUNDIALS IDA's BDF with KLU, is the one every
+// formulation uses today). A fixed-step comparison integrator is a function of this type in its
+// own file and its name in the formulation's row.
+using Integrator = IdaStats (*)(DaeProblem& problem, const IdaOptions& options, std::vector<double>& y,
+                                std::vector<double>& yp,
+                                const std::function<bool(double, const double*, const double*)>& output);
+
 struct Formulation {
   std::string name;
   std::string description;  // one line
@@ -30,6 +40,9 @@ struct Formulation {
   std::unique_ptr<MultibodyDae> (*make)(const System& sys, const FormulationParameters& p) = nullptr;
   // Uses the Baumgarte rates (reported in the summary).
   bool uses_baumgarte = false;
+  // The integrator that advances the DAE, and its name in summary.json.
+  Integrator integrator = &integrate;
+  const char* integrator_name = "ida";
 };
 
 // Every registered formulation, in the order they are documented (index3 first: the default).

@@ -59,6 +59,7 @@ void GglDae::error_weights(double h, const double* y, double rtol, double atol, 
   const double am = (atol + noise) / h;
   if (v_in_test_) {
     state_weights(h, y, rtol, atol, w);
+    error_per_unit_span(newton_step(h), y, w);
   } else {
     position_weights(y, rtol, aq, w);
     for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);

@@ -14,7 +14,8 @@
 // is controlled the same way as for an ODE (Brenan, Campbell, Petzold, Numerical Solution of
 // IVPs in DAEs, 3.2: BDF converges with order k for all components of a Hessenberg index-2
 // system, and only the index-2 variables need to be left out of the error estimate).
-// lambda and mu are left out (IDASetSuppressAlg). Measured: with v in the test, the phase of
+// lambda and mu are left out (IDASetSuppressAlg). Tolerances per unit of the run's span (issue
+// 21: the local errors of the steps add up to the tolerance over the run). Measured: with v in the test, the phase of
 // the solution is error-controlled; without, it is not, as at index 3 (compound pendulum, 5
 // periods, rtol 1e-9: period error 1e-9 with v tested, 2.6e-7 without, 1e-6 at index 3, for
 // 40 % more steps; five-point suspension dynamics I at rtol 1e-8: wheel_z within 6e-9 of an
@@ -43,7 +44,8 @@ class GglDae : public MultibodyDae {
   int residual(double t, const double* y, const double* yp, double* r) override;
   void error_test_mask(double* id) const override;
   // Newton-test (and error-test) weights. Positions: rtol|q| + atol. Velocities: rtol|v| +
-  // atol, plus the rounding floor of the positions amplified by 1/h when v is out of the
+  // atol (with v in the test: both per unit of the run's span, times h / S, error_per_unit_span,
+  // when the model's tolerances are set), plus the rounding floor of the positions amplified by 1/h when v is out of the
   // error test (atol floored at ten roundings of the largest |q|, |v|). The index-2 multipliers are a correction per step, of the size of the
   // error of q (mu) or of M v (lambda) divided by h: rtol|mu| + (atol + noise)/h and
   // rtol|lambda| + m_ref (atol + noise/h)/h.

@@ -80,7 +80,8 @@ class Index1Dae : public MultibodyDae {
   int residual(double t, const double* y, const double* yp, double* r) override;
   void error_test_mask(double* id) const override;
   // Positions rtol|q| + atol, velocities rtol|v| + atol (atol floored at ten roundings of the
-  // largest |q|, |v|); the index-1 multipliers follow the accelerations, whose error is that
+  // largest |q|, |v|), both per unit of the run's span (error_per_unit_span: times h / S, when
+  // the model's tolerances are set); the index-1 multipliers follow the accelerations, whose error is that
   // of v over h: rtol|lambda| + m_ref (atol + noise)/h.
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
 

@@ -131,6 +131,22 @@ void MultibodyDae::state_weights(double h, const double* y, double rtol, double 
   }
 }
 
+void MultibodyDae::error_per_unit_span(double h, const double* y, double* w) const {
+  if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
+  const double f = std::fmax(1.0, abs_tol_.span / h);
+  double rmax = abs_tol_.length, vmax = abs_tol_.length / abs_tol_.time;
+  for (int i = 0; i < nq_; i += 7) rmax = std::fmax(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
+  for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
+  const double e = kSpanRoundingFloor;
+  const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
+  const double w_velocity = 1.0 / (e * std::fmax(vmax, rmax / h)), w_rate = 1.0 / (e * std::fmax(1.0, 1.0 / h));
+  for (int i = 0; i < nq_; ++i) {
+    const bool euler = i % 7 >= 3;
+    w[i] = std::fmin(w[i] * f, std::fmax(w[i], euler ? w_rotation : w_length));
+    w[nq_ + i] = std::fmin(w[nq_ + i] * f, std::fmax(w[nq_ + i], euler ? w_rate : w_velocity));
+  }
+}
+
 void MultibodyDae::switches(double t_in, const double* y, double* g) {
   const double t = input_time(t_in);
   for (size_t k = 0; k < switch_forces_.size(); ++k) {

@@ -31,6 +31,7 @@ struct AbsoluteTolerances {
   double position = 0, rotation = 0, velocity = 0, rotation_rate = 0;
   double time = 1;  // [s] the model's time scale (velocity scale length / time)
   double length = 1;  // [m] the model's length scale
+  double span = 0;    // [s] the span of the run (0: unknown, no control per unit of span)
   bool set() const { return position > 0; }
 };
 
@@ -161,6 +162,13 @@ class MultibodyDae : public DaeProblem {
   // all when no model-unit tolerances are set), floored at rounding (position_atol,
   // velocity_atol).
   void state_weights(double h, const double* y, double rtol, double atol, double* w) const;
+  // Error per unit of the run's span (index2-ggl, index1, penalty; docs/formulation.md "Error
+  // control"): the weights of q and v (the first 2 nq of w) tightened by S/h, S the span and h
+  // the integrator's step, so that the local errors of the steps add up to about the tolerance
+  // over the run; never tighter than 100 roundings of the model's positions and velocities
+  // (positions max(L, |r|), velocities max(L/T, |v|, |r|/h)), never looser than before.
+  void error_per_unit_span(double h, const double* y, double* w) const;
+  static constexpr double kSpanRoundingFloor = 1e2 * 2.220446049250313e-16;
   // The integrator's step: 1/cj of the last Newton matrix (h before the first one).
   double newton_step(double h) const { return newton_cj_ > 0 ? 1.0 / newton_cj_ : h; }
   AbsoluteTolerances abs_tol_;

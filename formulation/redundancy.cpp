@@ -3,8 +3,11 @@
 #include <SuiteSparseQR.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "formulation/mechanics.h"
 #include "formulation/normalized_jacobian.h"
@@ -117,6 +120,96 @@ System without_redundant_constraints(const System& sys, const RedundancyReport& 
     if (c.type == Constraint::Type::kPoint) c.mask = report.keep[k];
     out.constraints.push_back(c);
   }
+  return out;
+}
+
+}  // namespace mbdae
+
+namespace mbdae {
+namespace {
+
+// The first dot-1 row of each cut (a revolute's or universal's axis1 on body i), by cut name.
+using CutAxes = std::unordered_map<std::string, const Constraint*>;
+CutAxes cut_axes(const System& sys) {
+  CutAxes out;
+  for (const Constraint& d : sys.constraints)
+    if (d.owner == Constraint::Owner::kCut && d.type == Constraint::Type::kDot1) out.emplace(d.owner_name, &d);
+  return out;
+}
+
+// The cut's frame for its point rows: on body i unless it is ground (then body j, sides
+// swapped), z along the cut's dot-1 axis on that side (a revolute's or universal's axis1), else
+// the body's own axes. `names` gets the rows' labels.
+Constraint frame_side(const System& sys, const CutAxes& dot1, const Constraint& pt, Mat3& axes,
+                      std::array<std::string, 3>& names) {
+  Constraint c = pt;
+  const bool swap = pt.bi < 0;
+  if (swap) {
+    std::swap(c.bi, c.bj);
+    std::swap(c.si, c.sj);
+  }
+  axes = Mat3::Identity();
+  for (int k = 0; k < 3; ++k) names[k] = sys.bodies[c.bi].name + " " + "xyz"[k];
+  const auto it = dot1.find(pt.owner_name);
+  if (swap || it == dot1.end() || it->second->bi != pt.bi) return c;
+  const Vec3 z = it->second->ai.normalized(), x = z.unitOrthogonal();
+  axes.col(0) = x;
+  axes.col(1) = z.cross(x);
+  axes.col(2) = z;
+  names = {"across axis1 (1)", "across axis1 (2)", "along axis1"};
+  return c;
+}
+
+}  // namespace
+
+System with_body_frame_cut_points(const System& sys, const std::vector<std::string>& cuts) {
+  const std::unordered_set<std::string> picked(cuts.begin(), cuts.end());
+  const CutAxes dot1 = cut_axes(sys);
+  System out = sys;
+  out.constraints.clear();
+  for (const Constraint& c : sys.constraints) {
+    const bool pick = c.owner == Constraint::Owner::kCut && c.type == Constraint::Type::kPoint &&
+                      picked.count(c.owner_name) && (c.bi >= 0 || c.bj >= 0);
+    if (!pick) {
+      out.constraints.push_back(c);
+      continue;
+    }
+    Mat3 axes;
+    std::array<std::string, 3> names;
+    const Constraint side = frame_side(sys, dot1, c, axes, names);
+    // One dot-2 row per frame axis (a cut's point constraint has all three components).
+    for (int k = 0; k < 3; ++k) {
+      Constraint r = side;
+      r.type = Constraint::Type::kDot2;
+      r.ai = axes.col(k);
+      r.mask = 7;
+      r.label = c.label + " [" + names[k] + "]";
+      out.constraints.push_back(r);
+    }
+  }
+  return out;
+}
+
+EquationChoice choose_independent_equations(const System& sys, const double* q, double t, double tolerance) {
+  EquationChoice out;
+  const RedundancyReport first = find_redundant_constraints(sys, q, t, tolerance);
+  // Cuts whose point equations are partly redundant: which components are kept depends on the
+  // frame they are written in. (All three redundant: the cut repeats a joint, in any frame.)
+  std::unordered_set<std::string> seen;
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    if (c.owner != Constraint::Owner::kCut || c.type != Constraint::Type::kPoint) continue;
+    if (first.keep[k] == 0 || first.keep[k] == c.mask) continue;
+    if (seen.insert(c.owner_name).second) out.reexpressed.push_back(c.owner_name);
+  }
+  if (out.reexpressed.empty()) {
+    out.system = without_redundant_constraints(sys, first);
+    out.report = first;
+    return out;
+  }
+  const System body_frame = with_body_frame_cut_points(sys, out.reexpressed);
+  out.report = find_redundant_constraints(body_frame, q, t, tolerance);
+  out.system = without_redundant_constraints(body_frame, out.report);
   return out;
 }
 

@@ -33,4 +33,25 @@ RedundancyReport find_redundant_constraints(const System& sys, const double* q, 
 // constraint keeps its independent components.
 System without_redundant_constraints(const System& sys, const RedundancyReport& report);
 
+// The equations to keep, chosen so that the choice stays valid as the mechanism moves. A cut's
+// coincident-point equations are written in world components; in a loop whose plane turns (a
+// four-bar on a turntable, a governor's pinned links) the dependent combination is a body-fixed
+// direction (the loop's normal), so a choice of world components made at one configuration goes
+// singular a quarter turn later. Here the point equations of every cut with some (not all) of
+// its point components redundant are first re-expressed as three point-on-plane (dot-2) rows
+// along a frame fixed in one of the cut's bodies (z along the cut's axis1 where it has one), then
+// the redundancy analysis runs again: the rows set aside are then the loop's own out-of-plane
+// rows in every configuration of a planar loop. Other cuts are left exactly as built.
+struct EquationChoice {
+  System system;                         // the equations kept
+  RedundancyReport report;               // the analysis of the re-expressed system
+  std::vector<std::string> reexpressed;  // the cuts whose point equations were re-expressed
+};
+EquationChoice choose_independent_equations(const System& sys, const double* q, double t,
+                                            double tolerance = 1e-9);
+
+// `sys` with the coincident-point equations of the named cuts re-expressed in a body frame, as
+// choose_independent_equations does (the same solutions, other rows).
+System with_body_frame_cut_points(const System& sys, const std::vector<std::string>& cuts);
+
 }  // namespace mbdae

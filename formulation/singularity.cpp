@@ -131,4 +131,25 @@ SingularityReport diagnose_singularity(const System& sys, const double* q, doubl
   return report;
 }
 
+namespace {
+double ratio(const SingularityReport& r) {
+  if (r.rank < r.equations) return 0.0;
+  return r.largest_singular_value > 0 ? r.smallest_singular_value / r.largest_singular_value : 0.0;
+}
+}  // namespace
+
+EquationChoiceCheck check_equation_choice(const System& all, const System& kept, const double* q, double t,
+                                          double singular_ratio) {
+  EquationChoiceCheck out;
+  out.kept_ratio = ratio(diagnose_singularity(kept, q, t));
+  out.set_aside = all.num_constraint_rows() - kept.num_constraint_rows();
+  const EquationChoice again = choose_independent_equations(all, q, t);
+  out.rechosen = again.report.redundant;
+  out.set_aside_again = static_cast<int>(again.report.redundant.size());
+  out.rechosen_ratio = ratio(diagnose_singularity(again.system, q, t));
+  out.degraded = out.set_aside > 0 && out.set_aside_again == out.set_aside && out.kept_ratio < singular_ratio &&
+                 out.rechosen_ratio >= singular_ratio;
+  return out;
+}
+
 }  // namespace mbdae

@@ -42,4 +42,19 @@ struct SingularityReport {
 SingularityReport diagnose_singularity(const System& sys, const double* q, double t,
                                        double min_weight = 0.05);
 
+// Whether a singular Jacobian of the kept equations is the mechanism's or the choice of equations
+// set aside: `all` is the system with every equation (as built), `kept` the one integrated. At q
+// the equations of `all` are chosen again (choose_independent_equations); the choice has
+// degraded where the kept equations are (nearly) singular, s_min / s_max below `singular_ratio`,
+// while the new choice sets aside as many equations and is not.
+struct EquationChoiceCheck {
+  bool degraded = false;
+  double kept_ratio = 0;      // s_min / s_max of the kept equations' row-normalized Jacobian
+  double rechosen_ratio = 0;  // the same for the equations chosen again at q
+  int set_aside = 0, set_aside_again = 0;  // how many equations each choice sets aside
+  std::vector<std::string> rechosen;       // the equations the new choice sets aside
+};
+EquationChoiceCheck check_equation_choice(const System& all, const System& kept, const double* q, double t,
+                                          double singular_ratio);
+
 }  // namespace mbdae

@@ -54,6 +54,7 @@ ModelScales model_scales(const System& sys, const double* q, double t0, double t
   s.length = box.extent() > 0 ? box.extent() : 1.0;
   const double span = t1 > t0 ? t1 - t0 : 1.0, g = sys.gravity.norm();
   s.time = g > 0 ? std::min(span, std::sqrt(s.length / g)) : span;
+  s.span = span;
   s.fast_time = s.time;
   for (const auto& f : sys.forces) {
     const double m = element_mass(sys, f.bi, f.bj);
@@ -70,6 +71,7 @@ AbsoluteTolerances absolute_tolerances(const ModelScales& s, double position_ato
   a.rotation_rate = a.rotation / s.time;
   a.time = s.time;
   a.length = s.length;
+  a.span = s.span;
   return a;
 }
 

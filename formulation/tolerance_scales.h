@@ -22,6 +22,7 @@ struct ModelScales {
   double length = 1.0;     // [m]
   double time = 1.0;       // [s]
   double fast_time = 1.0;  // [s]
+  double span = 1.0;       // [s] the run's span t1 - t0 (error per unit of span)
 };
 
 // From the configuration q (7 per body) and the span [t0, t1] of the run.

@@ -11,7 +11,10 @@ force, point and contact forces as arrows, the ground under a wheel, shapes as f
 .gif name, an animated GIF (Pillow). animate() and animation() are the same from Python.
 """
 import argparse
+import contextlib
+import io
 import json
+import math
 import os
 import xml.etree.ElementTree as ET
 
@@ -25,6 +28,67 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noq
 
 # Cell "part" codes (cases/output/animation_sink.h, legend.json).
 AXIS, BODY_LINE, BODY_POINT, JOINT, CUT, FORCE_LINE, FORCE_VECTOR, SHAPE, GROUND = range(9)
+
+# Frames per second of video at most. GIF frame delays are whole hundredths of a second and
+# viewers play delays under 2 cs as 10 cs, so a GIF holds at most 50 frames per second.
+MAX_FPS = {"gif": 50, "mp4": 60}
+
+
+def gif_delays(frames, fps):
+    """Frame delays in milliseconds (whole centiseconds, at least 2) for `frames` frames shown
+    at `fps` frames per second: each frame's delay rounded so that the time of frame k stays
+    within half a centisecond of k / fps (30 fps: 3, 4, 3, 3, 4, 3, ... cs)."""
+    if not 0 < fps <= MAX_FPS["gif"]:  # also NaN
+        raise ValueError(f"a GIF plays at most {MAX_FPS['gif']} frames per second (its frame delays are "
+                         f"hundredths of a second and viewers slow delays under 2 cs), got fps={fps}")
+    at = [round(100 * k / fps) for k in range(frames + 1)]
+    return [10 * (at[k + 1] - at[k]) for k in range(frames)]
+
+
+class _GifWriter:
+    """Grabs matplotlib frames and writes a GIF with gif_delays(): matplotlib's PillowWriter gives
+    every frame int(1000 / fps) ms, which Pillow cuts to whole centiseconds (60 fps: 1 cs, which
+    viewers play as 10 cs, six times too slow)."""
+
+    def __init__(self, fps):
+        self.fps = fps
+        self.frames = []
+
+    @contextlib.contextmanager
+    def saving(self, fig, out, dpi):
+        self.fig, self.dpi = fig, dpi
+        yield self
+        self.frames[0].save(out, save_all=True, append_images=self.frames[1:], loop=0,
+                            duration=gif_delays(len(self.frames), self.fps))
+
+    def grab_frame(self):
+        from PIL import Image
+
+        buf = io.BytesIO()
+        self.fig.savefig(buf, format="rgba", dpi=self.dpi)
+        w, h = int(round(self.fig.get_figwidth() * self.dpi)), int(round(self.fig.get_figheight() * self.dpi))
+        self.frames.append(Image.frombuffer("RGBA", (w, h), buf.getbuffer(), "raw", "RGBA", 0, 1).convert("RGB"))
+
+
+def frame_plan(times, fps=None, gif=False):
+    """(indices of the frames to draw, frames per second of video). With fps given, every frame
+    at that rate (a GIF at most 50). Without, real time: the frames' own rate when the format
+    allows it, else every k-th frame at 1/k of it (a 60 Hz run as a GIF: every second frame at
+    30 frames per second)."""
+    cap = MAX_FPS["gif" if gif else "mp4"]
+    n = len(times)
+    if fps is not None:
+        if not (fps > 0 and math.isfinite(fps)):
+            raise ValueError(f"fps must be a positive number, got {fps}")
+        if gif and fps > cap:
+            gif_delays(1, fps)  # raises the GIF's error
+        return list(range(n)), fps
+    span = times[-1] - times[0]
+    if n < 2 or span <= 0:
+        return list(range(n)), min(30, cap)
+    rate = (n - 1) / span  # frames per simulated second
+    k = max(1, math.ceil(rate / cap - 1e-9))
+    return list(range(0, n, k)), max(1.0, round(rate / k, 6))  # at least 1 frame per second of video
 
 
 def read_pvd(path):
@@ -43,8 +107,9 @@ def _cells(cell_array):
 
 
 def read_frame(path):
-    """One .vtp frame as numpy arrays: points, force_vector, and per cell section (verts, lines,
-    polys) the point ids and the cell fields, read with vtkXMLPolyDataReader."""
+    """One .vtp frame as numpy arrays: points, force_vector, per cell section (verts, lines,
+    polys) the point ids and the cell fields, and `names`, the field data's string arrays
+    (part_names, body_names, ...), read with vtkXMLPolyDataReader."""
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
 
@@ -56,8 +121,13 @@ def read_frame(path):
     data = reader.GetOutput()
     cd = data.GetCellData()
     fields = {cd.GetArrayName(k): vtk_to_numpy(cd.GetArray(k)) for k in range(cd.GetNumberOfArrays())}
+    fd = data.GetFieldData()
+    names = {}
+    for k in range(fd.GetNumberOfArrays()):  # the names the codes stand for (body_names, ...)
+        a = fd.GetAbstractArray(k)
+        names[a.GetName()] = [a.GetValue(i) for i in range(a.GetNumberOfValues())]
     frame = {"points": vtk_to_numpy(data.GetPoints().GetData()).astype(float),
-             "force_vector": vtk_to_numpy(data.GetPointData().GetArray("force_vector"))}
+             "force_vector": vtk_to_numpy(data.GetPointData().GetArray("force_vector")), "names": names}
     start = 0
     for name, section in (("verts", data.GetVerts()), ("lines", data.GetLines()), ("polys", data.GetPolys())):
         cells = _cells(section)
@@ -134,17 +204,19 @@ class _Scene:
 def animate(pvd, out, fps=None, start=None, end=None, max_frames=None, size=(640, 480), dpi=80,
             elev=20.0, azim=-60.0, title=None):
     """Draws the frames of `pvd` (within [start, end], at most max_frames of them, evenly
-    picked) into `out` (.mp4 or .gif). fps defaults to real time (capped at 60). Returns the
-    number of frames written."""
+    picked) into `out` (.mp4 or .gif). Returns the number of frames written. fps defaults to
+    real time (frame_plan: at most 60 frames per second for an MP4 and 50 for a GIF, denser
+    frames thinned evenly); a GIF's frame delays are whole centiseconds, rounded frame by frame
+    so that the video keeps the rate (gif_delays)."""
     entries = [(t, f) for t, f in read_pvd(pvd) if (start is None or t >= start) and (end is None or t <= end)]
     if not entries:
         raise ValueError(f"{pvd}: no frames in the time window")
     if max_frames and len(entries) > max_frames:
         entries = [entries[k] for k in np.linspace(0, len(entries) - 1, max_frames).round().astype(int)]
+    gif = out.lower().endswith(".gif")
+    keep, fps = frame_plan([t for t, _ in entries], fps, gif)
+    entries = [entries[k] for k in keep]
     frames = [read_frame(f) for _, f in entries]
-    if fps is None:
-        span = entries[-1][0] - entries[0][0]
-        fps = int(min(60, max(1, round((len(entries) - 1) / span)))) if span > 0 else 30
     fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     ax = fig.add_subplot(projection="3d")
     lo, hi = _limits(frames)
@@ -158,7 +230,7 @@ def animate(pvd, out, fps=None, start=None, end=None, max_frames=None, size=(640
     if scene.has_forces:
         fig.colorbar(scene.force, ax=ax, shrink=0.5, pad=0.12, label="|force| [N]")
     fig.subplots_adjust(left=0, right=0.95, bottom=0.02, top=0.92 if title else 0.98)
-    writer = mpl_animation.PillowWriter(fps=fps) if out.lower().endswith(".gif") else \
+    writer = _GifWriter(fps) if gif else \
         mpl_animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
     with writer.saving(fig, out, dpi=dpi):
         for (t, _), frame in zip(entries, frames):
@@ -183,7 +255,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("pvd")
     ap.add_argument("out", help=".mp4 or .gif")
-    ap.add_argument("--fps", type=int)
+    ap.add_argument("--fps", type=float)
     ap.add_argument("--start", type=float)
     ap.add_argument("--end", type=float)
     ap.add_argument("--max-frames", type=int)

@@ -77,22 +77,33 @@ void print_usage() {
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
                "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation %s]\n"
-               "       mbdae check SCENE.yaml\n", names.c_str());
+               "       mbdae check SCENE.yaml\n"
+               "       mbdae params SCENE.yaml\n"
+               "       mbdae --version\n", names.c_str());
 }
 
 std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl) {
-  if (args.size() < 2 || (args[0] != "run" && args[0] != "check")) {
+  if (args.size() == 1 && args[0] == "--version") {
+    cl.version = true;
+    return "";
+  }
+  if (args.size() < 2 || (args[0] != "run" && args[0] != "check" && args[0] != "params")) {
     cl.show_usage = true;
-    return "expected 'run SCENE.yaml' or 'check SCENE.yaml'";
+    return "expected 'run SCENE.yaml', 'check SCENE.yaml' or 'params SCENE.yaml'";
   }
   cl.check_only = args[0] == "check";
+  cl.list_params = args[0] == "params";
   cl.scene_path = args[1];
+  if (cl.list_params && args.size() > 2) {
+    cl.show_usage = true;
+    return "params takes the scene only, got '" + args[2] + "'";
+  }
   cl.options.verbose = cl.options.progress = true;
   for (size_t i = 2; i < args.size(); ++i) {
     const std::string why = read_option(args, i, cl);
     if (!why.empty()) return why;
   }
-  if (!cl.check_only && cl.out_dir.empty()) return "--out DIR is required";
+  if (!cl.check_only && !cl.list_params && cl.out_dir.empty()) return "--out DIR is required";
   return "";
 }
 

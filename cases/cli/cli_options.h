@@ -3,6 +3,8 @@
 //                         [--formulation index3|index2-ggl|index1|penalty]
 //                         [--animation] [--animation-rate HZ]
 //   mbdae check SCENE.yaml
+//   mbdae params SCENE.yaml     (every parameter path with its value and unit)
+//   mbdae --version
 // Overrides are checked with the scene fields' own range checks (cases/scene/field_ranges.h): the
 // tolerances as soon as they are read, the output step against each integration step's time
 // span once the scene is loaded.
@@ -17,6 +19,8 @@ namespace mbdae {
 
 struct CommandLine {
   bool check_only = false;
+  bool list_params = false;  // mbdae params: the scene's parameter paths (mbdae::parameters)
+  bool version = false;      // mbdae --version
   std::string scene_path;
   std::string out_dir;  // --out: results.csv and summary.json go there
   RunOptions options;

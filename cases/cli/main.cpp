@@ -1,6 +1,7 @@
 // mbdae command-line front end:
 //   mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--output-step DT]
 //                         [--formulation index3|index2-ggl|index1|penalty]
+//   mbdae check SCENE.yaml | mbdae params SCENE.yaml | mbdae --version
 // Exit codes (docs/errors.md): 0 success, 1 usage, 2 invalid scene, 3 solve failure, 4 output
 // or resource failure (a file that cannot be written, a folder in use, out of memory),
 // 128 + N stopped by signal N (SIGINT 130, SIGTERM 143).
@@ -20,6 +21,21 @@
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/system.h"
+#include "mbdae/version.h"
+
+namespace {
+
+// mbdae params: one line per parameter path, "path = value [unit]", in the scene's order; a
+// stdout that cannot be written (a full device) is exit code 4 with a message.
+int print_parameters(const mbdae::Scene& scene) {
+  for (const auto& p : mbdae::parameters(scene))
+    std::printf("%s = %s%s\n", p.path.c_str(), p.value.c_str(), p.unit.empty() ? "" : (" [" + p.unit + "]").c_str());
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return 0;
+  std::fprintf(stderr, "mbdae: cannot write the parameter list to stdout (%s)\n", std::strerror(errno));
+  return 4;
+}
+
+}  // namespace
 
 namespace {
 
@@ -50,10 +66,15 @@ int run_command(int argc, char** argv) {
     if (cl.show_usage) mbdae::print_usage();
     return 1;
   }
+  if (cl.version) {
+    std::printf("mbdae %s\n", MBDAE_VERSION);
+    return 0;
+  }
   mbdae::RunOptions& opt = cl.options;
-  if (!cl.check_only) opt.stop = mbdae::install_stop_signals();  // check: Ctrl-C ends it at once
+  if (!cl.check_only && !cl.list_params) opt.stop = mbdae::install_stop_signals();  // check, params: Ctrl-C ends it at once
   try {
     const mbdae::Scene scene = mbdae::load_scene(cl.scene_path);
+    if (cl.list_params) return print_parameters(scene);
     if (cl.check_only) {
       const mbdae::System sys = mbdae::build_system(scene.model);
       std::printf("%s: ok (%d bodies, %d coordinates, %d constraint equations)\n", cl.scene_path.c_str(),

@@ -72,8 +72,8 @@ def plot(table, path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default="build/wheel_hop")
-    ap.add_argument("--scheduler", help="a Dask scheduler's address (default: a local cluster)")
-    ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    ap.add_argument("--scheduler", help="a Dask scheduler's address (default: threads of this process)")
+    ap.add_argument("--workers", type=int, help="local threads (default: one per core)")
     ap.add_argument("--t-end", type=float, help="shorter runs (the poster's first contact loss is after 13 s)")
     ap.add_argument("--damping", default="700:2800:8", help="A:B:N [N s/m]")
     ap.add_argument("--stiffness", default="1e5:4e5:5", help="A:B:N tyre stiffness [N/m]")

@@ -33,12 +33,13 @@ san=(-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 cxxflags=(-std=c++17 -O1 -g "${san[@]}" -fsanitize=fuzzer-no-link
   -I"$root" -I/usr/include/eigen3 -I/usr/include/suitesparse
   -DMBDAE_FUZZ_SCENE_PATH="\"$here/scene.yaml\"" -Wno-unused-command-line-argument)
-# Libraries: yaml-cpp and every find_library(VAR name ...) of the top-level CMakeLists.txt (an
-# optional one, without REQUIRED, only where the linker finds it: sundials_core on SUNDIALS 7).
+# Libraries: yaml-cpp and every mbdae_import_library(TARGET name [OPTIONAL]) of
+# cases/package/mbdae_dependencies.cmake, the file the build finds them with (an OPTIONAL one
+# only where the linker finds it: sundials_core on SUNDIALS 7).
 libs=(-lyaml-cpp)
-while read -r l required; do
-  if [[ -n "$required" ]] || "$cxx" -l"$l" -shared -o /dev/null -x c /dev/null 2>/dev/null; then libs+=("-l$l"); fi
-done < <(sed -n 's/^[[:space:]]*find_library([[:space:]]*[A-Za-z_0-9]*[[:space:]][[:space:]]*\([A-Za-z_0-9.+-]*\)[^R]*\(REQUIRED\)\{0,1\}.*/\1 \2/p' "$root/CMakeLists.txt")
+while read -r l optional; do
+  if [[ -z "$optional" ]] || "$cxx" -l"$l" -shared -o /dev/null -x c /dev/null 2>/dev/null; then libs+=("-l$l"); fi
+done < <(sed -n 's/^[[:space:]]*mbdae_import_library([[:space:]]*[A-Za-z_0-9]*[[:space:]][[:space:]]*\([A-Za-z_0-9.+-]*\)[[:space:]]*\(OPTIONAL\)\{0,1\}[[:space:]]*).*/\1 \2/p' "$root/cases/package/mbdae_dependencies.cmake")
 [[ ${#libs[@]} -gt 1 ]] || libs+=(-lsundials_ida -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
 
 # Sources: those of the libraries mbdae_core, mbdae_formulation and mbdae_scene as listed in the

@@ -1,10 +1,15 @@
 #include "cases/output/animation_sink.h"
 
+#include <sys/statvfs.h>
+
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
+#include "cases/scene/analysis_types.h"
+#include "core/errors.h"
 #include "core/output.h"
 #include "formulation/euler_parameters.h"
 #include "formulation/forces.h"
@@ -227,15 +232,16 @@ void draw_forces(const System& sys, const double* q, const double* v, const std:
     const Force& f = sys.forces[k];
     if (f.type == ForceSpec::Type::kTorque || f.type == ForceSpec::Type::kJointSpringDamper) continue;  // no line
     LoadInput in;
-    if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
-    const LocalState x = gather(q, f.bi, f.bj), xd = gather(v, f.bi, f.bj);
-    const double value = force_magnitude(f, x, xd, t, modes[k], &in);
+    const bool evaluate = v != nullptr;  // null: only the frame's layout is wanted (its size)
+    if (evaluate && f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+    const LocalState x = gather(q, f.bi, f.bj), xd = evaluate ? gather(v, f.bi, f.bj) : LocalState{};
+    const double value = evaluate ? force_magnitude(f, x, xd, t, modes[k], &in) : 0.0;
     const Vec3 xi = world({f.bi, f.si}, q);
     const int index = static_cast<int>(k);
     if (f.type == ForceSpec::Type::kPointForce || f.type == ForceSpec::Type::kWheelContact) {
       // The world force is the translational part of its generalized force on its body.
       Vec14 generalized = Vec14::Zero();
-      force_eval(f, x, xd, t, modes[k], generalized, nullptr, nullptr, &in);
+      if (evaluate) force_eval(f, x, xd, t, modes[k], generalized, nullptr, nullptr, &in);
       const Vec3 vec = f.type == ForceSpec::Type::kPointForce ? Vec3(generalized.head<3>()) : Vec3(0, 0, value);
       pt.cell(pt.data.verts, {pt.add_point(xi, vec)}, AnimationPart::kForceVector, -1, index, -1, value);
       if (f.type == ForceSpec::Type::kWheelContact) {
@@ -262,10 +268,12 @@ void draw_shapes(const AnimationPlan& plan, const double* q, Painter& pt) {
   }
 }
 
+const std::vector<std::string> kPartNames = {"axis", "body_line", "body_point", "joint", "cut",
+                                             "force_line", "force_vector", "shape", "ground"};
+
 nlohmann::ordered_json legend(const AnimationPlan& plan, const System& sys) {
   nlohmann::ordered_json j;
-  j["parts"] = {{"0", "axis"}, {"1", "body_line"}, {"2", "body_point"}, {"3", "joint"},
-                {"4", "cut"}, {"5", "force_line"}, {"6", "force_vector"}, {"7", "shape"}, {"8", "ground"}};
+  for (size_t k = 0; k < kPartNames.size(); ++k) j["parts"][std::to_string(k)] = kPartNames[k];
   j["cell_fields"] = kCellFieldNames;
   j["point_fields"] = {"force_vector"};
   j["axis_length"] = plan.axis_length;
@@ -277,26 +285,85 @@ nlohmann::ordered_json legend(const AnimationPlan& plan, const System& sys) {
   return j;
 }
 
+// An empty frame with its fields, and the names the codes stand for as field data.
+void setup_polydata(VtkPolyData& d, const AnimationPlan& plan, const System& sys) {
+  d.point_fields = {VtkField{"force_vector", 3, {}}};
+  d.cell_fields = kCellFieldNames;
+  for (VtkCells* c : {&d.verts, &d.lines, &d.polys}) c->fields.assign(kNumCellFields, {});
+  VtkStrings bodies{"body_names", {}}, forces{"force_names", {}};
+  for (const auto& b : plan.bodies) bodies.values.push_back(b.name);
+  for (const auto& f : sys.forces) forces.values.push_back(f.name);
+  d.field_data = {{"part_names", kPartNames}, bodies, {"joint_names", plan.joint_names}, {"cut_names", plan.cut_names},
+                  forces};
+}
+
+// A frame's points and cells at the state (q, v); v null: the layout only (forces not evaluated).
+void draw(const AnimationPlan& plan, const System& sys, const double* q, const double* v,
+          const std::vector<char>& modes, double input_time, VtkPolyData& data) {
+  data.clear();
+  Painter pt{data};
+  draw_bodies(plan, q, pt);
+  draw_constraints(plan, q, pt);
+  draw_forces(sys, q, v, modes, input_time, pt);
+  draw_shapes(plan, q, pt);
+}
+
+// A name written by the animation: frame_ and six or more digits, .vtp (or its .tmp).
+bool is_frame_file(const std::string& name) {
+  size_t k = 6;
+  if (name.rfind("frame_", 0) != 0) return false;
+  while (k < name.size() && name[k] >= '0' && name[k] <= '9') ++k;
+  const std::string rest = name.substr(k);
+  return k >= 12 && (rest == ".vtp" || rest == ".vtp.tmp");
+}
+
+// True for a .pvd that mbdae wrote: a collection whose data sets are all animation/frame_*.vtp.
+bool is_our_pvd(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size > (64u << 20)) return false;  // 1e5 frames take 10 MB
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  std::string text(size, '\0');
+  text.resize(std::fread(text.data(), 1, text.size(), f));
+  std::fclose(f);
+  if (text.find("<VTKFile type=\"Collection\"") == std::string::npos) return false;
+  for (size_t at = text.find("file=\""); at != std::string::npos; at = text.find("file=\"", at + 1)) {
+    const size_t end = text.find('"', at + 6);
+    if (end == std::string::npos) return false;
+    const std::string file = text.substr(at + 6, end - at - 6);
+    if (file.rfind(std::string(kFolder) + "/", 0) != 0 || !is_frame_file(file.substr(std::strlen(kFolder) + 1)))
+      return false;
+  }
+  return true;
+}
+
 // Makes DIR/animation and removes the files of an earlier run from it.
 void prepare_folder(const std::string& dir) {
-  namespace fs = std::filesystem;
-  const fs::path folder = fs::path(dir) / kFolder;
-  fs::create_directories(folder);
-  for (const auto& e : fs::directory_iterator(folder)) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind("frame_", 0) == 0 || name == "legend.json") fs::remove(e.path());
-  }
-  fs::remove(fs::path(dir) / "animation.pvd");
+  remove_animation_files(dir);
+  std::filesystem::create_directories(std::filesystem::path(dir) / kFolder);
 }
 
 }  // namespace
 
+void remove_animation_files(const std::string& dir) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(dir) / kFolder, pvd = fs::path(dir) / "animation.pvd";
+  std::error_code ec;
+  if (fs::is_regular_file(pvd, ec) && is_our_pvd(pvd)) fs::remove(pvd);
+  if (fs::is_regular_file(fs::path(dir) / "animation.pvd.tmp", ec)) fs::remove(fs::path(dir) / "animation.pvd.tmp");
+  if (!fs::is_directory(folder, ec)) return;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file() && (is_frame_file(name) || name == "legend.json" || name == "legend.json.partial"))
+      fs::remove(e.path());
+  }
+  fs::remove(folder, ec);  // only when empty: a folder holding other files stays
+}
+
 AnimationSink::AnimationSink(const Scene& scene, std::string dir, double frame_rate)
     : scene_(scene), dir_(std::move(dir)), spec_(scene.animation) {
   if (frame_rate > 0) spec_.frame_rate = frame_rate;
-  data_.point_fields = {VtkField{"force_vector", 3, {}}};
-  data_.cell_fields = kCellFieldNames;
-  for (VtkCells* c : {&data_.verts, &data_.lines, &data_.polys}) c->fields.assign(kNumCellFields, {});
 }
 
 AnimationSink::~AnimationSink() = default;
@@ -305,7 +372,9 @@ void AnimationSink::start(std::unique_ptr<System> system, double t0, double t_en
   system_ = std::move(system);
   const System& sys = *system_;
   plan_ = std::make_unique<AnimationPlan>(make_plan(sys, scene_));
+  setup_polydata(data_, *plan_, sys);
   prepare_folder(dir_);
+  pvd_.open(dir_ + "/animation.pvd");
   const double span = std::min(t_end, spec_.end) - std::max(t0, spec_.start);
   frame_step_ = 1.0 / spec_.frame_rate;
   if (span > 0 && span / frame_step_ + 1 > spec_.max_frames) frame_step_ = span / (spec_.max_frames - 1);
@@ -344,20 +413,13 @@ void AnimationSink::write_frame(double t, const double* q, const double* v, cons
     plan_->axis_length = spec_.axis_length > 0 ? spec_.axis_length : automatic_axis_length(*plan_, q);
     write_json_file(dir_ + "/" + kFolder + "/legend.json", legend(*plan_, *system_));
   }
-  data_.clear();
-  Painter pt{data_};
-  draw_bodies(*plan_, q, pt);
-  draw_constraints(*plan_, q, pt);
-  draw_forces(*system_, q, v, modes, input_time, pt);
-  draw_shapes(*plan_, q, pt);
+  draw(*plan_, *system_, q, v, modes, input_time, data_);
   char name[64];
   std::snprintf(name, sizeof name, "%s/frame_%06zu.vtp", kFolder, entries_.size());
-  write_vtp(dir_ + "/" + name, data_);
+  write_vtp(dir_ + "/" + name, data_, spec_.format, &scratch_);
   entries_.push_back({t, name});
-  if (entries_.size() % 32 == 0) write_collection();  // valid if the run is stopped
+  pvd_.add(entries_.back());  // the collection is whole after every frame
 }
-
-void AnimationSink::write_collection() { write_pvd(dir_ + "/animation.pvd", entries_); }
 
 // A scene without integration (assembly, equilibrium) is drawn once, at its final configuration.
 void AnimationSink::write_static_frame(const Result& result) {
@@ -387,10 +449,89 @@ void AnimationSink::end(const Result& result) {
       write_frame(last_t_, last_q_.data(), last_v_.data(), last_modes_, last_input_time_);
       last_pending_ = false;
     }
-    if (!entries_.empty()) write_collection();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mbdae: animation: %s\n", e.what());
   }
+  pvd_.close();
+}
+
+}  // namespace mbdae
+
+namespace mbdae {
+
+namespace {
+
+// The most frames a run of `scene` writes: per integrating step, one per frame step over the
+// window (max_frames at most) and the step's last sample; one for a scene without integration.
+long planned_frames(const Scene& scene, const AnimationSpec& spec, bool* by_max_frames) {
+  long most = 1;
+  *by_max_frames = false;
+  for (const auto& st : scene.steps) {
+    if (!integrates(st)) continue;
+    const double span = std::min(st.t_end, spec.end) - std::max(st.t0, spec.start);
+    if (!(span >= 0)) continue;
+    const double by_rate = std::floor(span * spec.frame_rate * (1 + 1e-9)) + 1;
+    const long frames = static_cast<long>(std::min<double>(spec.max_frames, by_rate)) + 1;
+    if (frames > most) {
+      most = frames;
+      *by_max_frames = spec.max_frames < by_rate;
+    }
+  }
+  return most;
+}
+
+std::string megabytes(double bytes) {
+  char buf[40];
+  if (bytes >= 1e12 - 5e8) std::snprintf(buf, sizeof buf, "%.3g TB", bytes / 1e12);
+  else if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
+  else if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.3g MB", bytes / 1e6);
+  else std::snprintf(buf, sizeof buf, "%.3g kB", bytes / 1e3);
+  return buf;
+}
+
+// Free bytes for an unprivileged writer on the file system of `dir` (or of its nearest existing
+// parent, as the folder may not exist yet); -1 if unknown.
+double free_bytes(const std::string& dir) {
+  std::filesystem::path p = std::filesystem::absolute(dir.empty() ? "." : dir);
+  std::error_code ec;
+  while (!std::filesystem::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
+  struct statvfs st;
+  // No blocks at all (/proc, /sys): not a place for files; claiming the folder says why.
+  if (::statvfs(p.c_str(), &st) != 0 || st.f_blocks == 0) return -1;
+  return static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
+}
+
+}  // namespace
+
+void check_animation_size(const Scene& scene, const std::string& dir, double frame_rate) {
+  AnimationSpec spec = scene.animation;
+  if (frame_rate > 0) spec.frame_rate = frame_rate;
+  const System sys = build_system(scene.model);
+  const AnimationPlan plan = make_plan(sys, scene);
+  VtkPolyData data;
+  setup_polydata(data, plan, sys);
+  draw(plan, sys, sys.q0.data(), nullptr, std::vector<char>(sys.forces.size(), 0), 0.0, data);
+  bool by_max_frames = false;
+  const long frames = planned_frames(scene, spec, &by_max_frames);
+  const double frame = static_cast<double>(vtp_size_bound(data, spec.format));
+  const double total = frames * (frame + 160.0) + 65536;  // frames, their .pvd lines, legend.json
+  const std::string what = "the animation may take up to " + megabytes(total) + " (" + std::to_string(frames) +
+                           " frames of up to " + megabytes(frame) + ")";
+  if (total > spec.disk_budget_mb * 1e6) {
+    // Blame what sets the frame count: max_frames, else the frame rate (the scene's or the option's).
+    SourceLocation at = by_max_frames ? spec.max_frames_at : spec.frame_rate_at;
+    if (at.line <= 0) at = spec.section.line > 0 ? spec.section : SourceLocation{scene.file, 0};
+    std::string field = by_max_frames ? "max_frames" : "frame_rate";
+    if (!by_max_frames && frame_rate > 0) at = {scene.file, 0}, field = "--animation-rate";
+    throw ModelError(at.file, at.line, field,
+                     what + ", more than its disk budget of " + megabytes(spec.disk_budget_mb * 1e6) +
+                         " (animation.disk_budget_mb): lower max_frames or frame_rate, narrow the window "
+                         "(start, end), or raise disk_budget_mb");
+  }
+  const double free = free_bytes(dir);
+  if (free >= 0 && total > free)
+    throw OutputError("output folder '" + dir + "': " + what + ", more than the " + megabytes(free) +
+                      " free on its file system: free some space, or lower animation.max_frames or frame_rate");
 }
 
 }  // namespace mbdae

@@ -1,6 +1,8 @@
 // An output sink (cases/mbdae.h) that writes the run as a ParaView time series: one VTK XML
 // PolyData file per frame, DIR/animation/frame_NNNNNN.vtp, the collection DIR/animation.pvd with
-// their times, and DIR/animation/legend.json naming what the codes in the files stand for.
+// their times, and DIR/animation/legend.json naming what the codes in the files stand for (the
+// names are also the field data of every frame: part_names, body_names, joint_names, cut_names,
+// force_names). Binary (zlib-compressed appended data) unless the scene asks for ASCII.
 // Each frame draws every body's frame (origin and axes), its named points and the lines joining
 // them, joints and loop cuts as points, force elements as lines with their force, point and
 // contact forces as vectors, and the scene's shapes as polygons (docs/animation.md).
@@ -26,6 +28,19 @@ enum class AnimationPart {
   kGround = 8  // the ground under a wheel contact: a line of the wheel's diameter at the ground height
 };
 
+// Checks before a run that its animation into `dir` fits: the frames it may write (max_frames, or
+// fewer from the frame rate and the time span) times an upper bound of a frame's size
+// (vtp_size_bound of the first frame) must be within the scene's disk_budget_mb (ModelError
+// naming the field, exit code 2) and the free space of dir's file system (statvfs; OutputError,
+// exit code 4). `frame_rate` > 0 overrides the scene's. docs/animation.md ("Size").
+void check_animation_size(const Scene& scene, const std::string& dir, double frame_rate = 0);
+
+// Removes what an earlier run's animation left in `dir`: animation.pvd (when it is mbdae's: a
+// collection of animation/frame_NNNNNN.vtp), animation/frame_NNNNNN.vtp, animation/legend.json,
+// their temporary files (.tmp, .partial), and animation/ when that leaves it empty. Other files
+// stay.
+void remove_animation_files(const std::string& dir);
+
 class AnimationSink : public Sink {
  public:
   // `scene` must outlive the sink; `frame_rate` > 0 overrides the scene's.
@@ -38,7 +53,6 @@ class AnimationSink : public Sink {
 
  private:
   void write_frame(double t, const double* q, const double* v, const std::vector<char>& modes, double input_time);
-  void write_collection();
   void start(std::unique_ptr<System> system, double t0, double t_end);
   void write_static_frame(const Result& result);
 
@@ -52,7 +66,9 @@ class AnimationSink : public Sink {
   std::unique_ptr<AnimationPlan> plan_;
   double frame_step_ = 0, next_time_ = 0;
   std::vector<PvdEntry> entries_;
+  PvdAppender pvd_;  // DIR/animation.pvd, one line per frame
   VtkPolyData data_;
+  VtkScratch scratch_;
   // The last sample not written as a frame (written at the end, so the run's end is shown).
   std::vector<double> last_q_, last_v_;
   std::vector<char> last_modes_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/vtk_xml.h"
 #include "formulation/model.h"
 
 namespace mbdae {
@@ -24,10 +25,16 @@ struct AnimationShape {
   SourceLocation where;
 };
 
+// Frames at most: 1e5 frames of the suspension are 0.4 GB binary, 1.3 GB ASCII (docs/animation.md).
+inline constexpr int kMaxAnimationFrames = 100000;
+
 struct AnimationSpec {
   bool write = false;       // write the animation without --animation
   double frame_rate = 60;   // frames per second of simulated time
   int max_frames = 2000;    // cap: the frame step grows to keep the frame count under it
+  double disk_budget_mb = 1000;  // the frames' size bound may not exceed it (megabytes, 1e6 bytes)
+  VtkFormat format = VtkFormat::kBinary;  // `format: binary` (zlib-compressed) or `ascii`
+  SourceLocation section, frame_rate_at, max_frames_at, disk_budget_at;  // line 0: not given
   double start = -std::numeric_limits<double>::infinity();  // window of simulated time
   double end = std::numeric_limits<double>::infinity();
   double axis_length = 0;   // drawn body axes [m]; 0: a tenth of the mechanism's extent

@@ -15,8 +15,13 @@ void SummarySink::end(const Result& result) { write_json_file(path_, result.summ
 
 RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
   RunSinks s;
+  // The animation's size bound against its disk budget and the free space, before any folder
+  // is claimed or changed (cases/output/animation_sink.h).
+  if (!request.animation_dir.empty()) check_animation_size(scene, request.animation_dir, request.animation_rate);
   if (!request.out_dir.empty()) {
     s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
+    // An earlier run's animation files, when this run writes none there.
+    if (request.animation_dir != request.out_dir) remove_animation_files(request.out_dir);
     s.csv = std::make_unique<CsvSink>(request.out_dir + "/results.csv");
     s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
     s.list = {s.csv.get(), s.summary.get()};

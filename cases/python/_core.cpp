@@ -120,6 +120,15 @@ void bind_scene(py::module_& m) {
   m.def("set_parameter", &mbdae::set_parameter, py::arg("scene"), py::arg("path"), py::arg("yaml_value"));
   m.def("with_parameters", &mbdae::with_parameters, py::arg("scene"), py::arg("overrides"));
   m.def("formulations", &mbdae::formulations);
+  // Scene.parameters() and Scene.output_columns() (docs/python.md).
+  m.def("parameters", [](const mbdae::Scene& scene) {
+    std::vector<py::dict> out;
+    for (const auto& p : mbdae::parameters(scene))
+      out.push_back(py::dict(py::arg("path") = p.path, py::arg("value") = p.value, py::arg("unit") = p.unit,
+                             py::arg("file") = p.file, py::arg("line") = p.line));
+    return out;
+  }, py::arg("scene"));
+  m.def("output_columns", &mbdae::output_columns, py::arg("scene"));
 }
 
 void bind_run(py::module_& m) {
@@ -156,6 +165,7 @@ void bind_run(py::module_& m) {
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "mbdae's C++ API (cases/mbdae.h); use the mbdae package, not this module";
+  m.attr("__version__") = MBDAE_PY_VERSION;  // project(mbdae VERSION ...), cases/python/CMakeLists.txt
   // Scene and model errors as one exception carrying the CLI's lines (file:line: field 'x': ...);
   // the package turns them into mbdae.SceneError with the fields parsed.
   static py::exception<mbdae::SceneError> scene_error(m, "SceneErrorLines", PyExc_ValueError);

@@ -7,6 +7,8 @@ void set_parameter(Scene& scene, const std::string& path, const std::string& yam
   scene = reload_scene(scene, {{path, yaml_value}});
 }
 
+std::vector<ParameterEntry> parameters(const Scene& scene) { return scene_parameters(scene); }
+
 Scene with_parameters(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides) {
   return reload_scene(scene, overrides);
 }

@@ -22,7 +22,8 @@ std::string num(double x, int digits = 6) {
 FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vector<char>& modes,
                                               const std::vector<int>& columns, const double* q,
                                               const double* v, double t, double t_input,
-                                              double condition, const std::string& solver_message) {
+                                              double condition, const std::string& solver_message,
+                                              const System* all) {
   using json = nlohmann::ordered_json;
   FailureDiagnosis out;
   // The last configuration: driven coordinates (their value and the drive's), then the sensors
@@ -65,6 +66,24 @@ FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vect
                                         {"losing_rank", r.constraints},
                                         {"dependent_equations", dependent}};
   if (!out.singular) return out;
+  if (all && all->num_constraint_rows() > sys.num_constraint_rows()) {
+    const EquationChoiceCheck ck = check_equation_choice(*all, sys, q, t_input, kSingularRatio);
+    out.degraded_choice = ck.degraded;
+    out.details["equation_choice"] = {{"degraded", ck.degraded},
+                                      {"kept_ratio", ck.kept_ratio},
+                                      {"rechosen_ratio", ck.rechosen_ratio},
+                                      {"set_aside", ck.set_aside},
+                                      {"set_aside_again", ck.set_aside_again},
+                                      {"rechosen", ck.rechosen}};
+    if (ck.degraded) {
+      out.message = "the equations set aside as redundant at the start are no longer the dependent ones at t = " +
+                    num(t, 10) + " (a degraded equation choice, not a singular configuration): the kept equations' "
+                    "row-normalized Jacobian has s_min / s_max = " + num(ck.kept_ratio, 3) +
+                    ", with the equations chosen again there " + num(ck.rechosen_ratio, 3) +
+                    "; last reached configuration: " + reached.str() + " (solver: " + solver_message + ")";
+      return out;
+    }
+  }
 
   std::ostringstream os;
   if (targets.tellp() > 0)

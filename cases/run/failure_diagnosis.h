@@ -23,6 +23,7 @@ constexpr double kNamedWeight = 0.5;
 
 struct FailureDiagnosis {
   bool singular = false;
+  bool degraded_choice = false;  // singular only for the equations kept: the mechanism is not
   std::string message;       // the replacement message when singular (else empty)
   nlohmann::ordered_json details;  // "last_configuration" and "singular_configuration" entries
 };
@@ -30,9 +31,13 @@ struct FailureDiagnosis {
 // q and v at the last step reached (time t, inputs evaluated at t_input); `columns` are the
 // sensors of the output file (reported in the last configuration, accelerations left out);
 // `condition` is the constraint condition estimate at q (AugmentedSolver::constraint_condition).
+// `all`, if given, is the system with every equation as built (sys without its redundant ones):
+// a singular Jacobian is then told apart as the mechanism's or the equation choice's
+// (check_equation_choice), and the message says which.
 FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vector<char>& modes,
                                               const std::vector<int>& columns, const double* q,
                                               const double* v, double t, double t_input,
-                                              double condition, const std::string& solver_message);
+                                              double condition, const std::string& solver_message,
+                                              const System* all = nullptr);
 
 }  // namespace mbdae

@@ -117,12 +117,53 @@ bool start(RunContext& c, const AnalysisStep& step, MultibodyDae& dae, std::vect
   return true;
 }
 
+// The equations set aside as redundant, watched at every output sample. While the choice is
+// valid they depend on the kept ones and hold as well as those do; a loop opening along them
+// means the choice degraded and the motion is no longer the mechanism's (the penalty
+// formulation, whose Newton matrix stays regular, would run on): the run stops, never `ok`.
+struct SetAsideWatch {
+  const System* all = nullptr;  // null: nothing set aside
+  std::vector<int> off_all, off_kept;
+  std::vector<double> phi_all, phi_kept;
+  double floor = 0;  // the positions' promise: 10 rtol of the model's length
+  bool degraded = false;
+  double violation = 0, kept_violation = 0, t = 0;  // at the sample that failed
+
+  SetAsideWatch(const RunContext& c, const StepTolerances& tol, double rtol) {
+    if (!c.all_equations || c.all_equations->num_constraint_rows() <= c.system->num_constraint_rows()) return;
+    all = c.all_equations.get();
+    off_all = constraint_offsets(*all);
+    off_kept = constraint_offsets(*c.system);
+    phi_all.resize(off_all.back());
+    phi_kept.resize(off_kept.back());
+    floor = 10 * rtol * tol.scales.length;
+  }
+  // False where the equations set aside fail by more than 100 times the kept ones and by more
+  // than the floor. Measured on the turntable four-bar: 1 to 2.5 times with the body-frame
+  // choice (every formulation), 172 at the quarter turn with the world choice (penalty, which
+  // ends 1.3 rad off otherwise).
+  bool operator()(const System& kept, const double* q, double t_input) {
+    if (!all) return true;
+    constraint_values(*all, off_all, q, t_input, phi_all.data());
+    constraint_values(kept, off_kept, q, t_input, phi_kept.data());
+    const double va = max_abs(phi_all.data(), static_cast<int>(phi_all.size()));
+    const double vk = max_abs(phi_kept.data(), static_cast<int>(phi_kept.size()));
+    if (va <= std::fmax(100 * vk, floor)) return true;
+    degraded = true;
+    violation = va;
+    kept_violation = vk;
+    t = t_input;
+    return false;
+  }
+};
+
 // Evaluates each output sample once: the consistent state, the sensors, the Result's columns
 // (reserved up front), the sinks, the quiet-sensor watch and the progress line.
 struct Sampler {
   RunContext& c;
   const AnalysisStep& step;
   MultibodyDae& dae;
+  SetAsideWatch& set_aside;
   std::vector<double> qo, vo, ao, sensors, row;
   double max_output_violation = 0;
   std::vector<int> quiet;
@@ -131,8 +172,8 @@ struct Sampler {
   bool printed = false;
   std::string sink_error;  // a sink's failure (stops the run)
 
-  Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, double output_step)
-      : c(c_), step(s), dae(d), sensors(c_.system->sensors.size()), row(c_.result.columns.size()) {
+  Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, SetAsideWatch& w, double output_step)
+      : c(c_), step(s), dae(d), set_aside(w), sensors(c_.system->sensors.size()), row(c_.result.columns.size()) {
     const System& sys = *c.system;
     for (const auto& name : step.quiet_sensors)
       for (size_t k = 0; k < sys.sensors.size(); ++k)
@@ -148,6 +189,7 @@ struct Sampler {
     max_output_violation =
         std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
     if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
+    if (!set_aside(sys, qo.data(), dae.input_time(t))) return false;  // not the mechanism's motion: not written
     // Coordinate sensors count whole turns as the loads do (formulation/system.h, CoordinateTurns).
     evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(), nullptr,
                      &dae.turns);
@@ -219,9 +261,9 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
     const System& sys = *c.system;
     const FailureDiagnosis d = diagnose_integration_failure(
         sys, dae.modes, c.column_sensors, c.q.data(), y.data() + sys.nq(), st.t_reached, dae.input_time(st.t_reached),
-        dae.augmented().constraint_condition(c.q.data()), st.message);
+        dae.augmented().constraint_condition(c.q.data()), st.message, c.all_equations.get());
     for (const auto& [key, value] : d.details.items()) js[key] = value;
-    if (d.singular) {
+    if (d.singular || d.degraded_choice) {
       js["solver_message"] = st.message;
       message = d.message;
     }
@@ -239,6 +281,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");
   js["formulation"] = name;
+  js["integrator"] = f->integrator_name;
   const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
   const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
   const IdaOptions io = integration_options(c.options, step, tol, js);
@@ -255,9 +298,10 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
     c.result.exit_code = 4;
     return false;
   }
-  Sampler sampler(c, step, *dae, io.output_step);
+  SetAsideWatch watch(c, tol, io.rtol);
+  Sampler sampler(c, step, *dae, watch, io.output_step);
   const size_t rows_before = c.result.rows();
-  const IdaStats st = integrate(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
+  const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
   std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
   c.turns = dae->turns;
@@ -277,6 +321,16 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
                 st.event_times.size(), st.cpu_seconds, dae->max_position_violation);
   if (!dae->output_failure.empty()) {
     fail(c, "output_solve_failed", dae->output_failure, js);
+    return false;
+  }
+  if (watch.degraded) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "the equations set aside as redundant at the start no longer hold at t = %.10g (violated by "
+                  "%.3g where the kept ones hold to %.3g): a degraded equation choice, the motion from there on "
+                  "is not the mechanism's",
+                  watch.t, watch.violation, watch.kept_violation);
+    fail(c, "integration_failed", buf, js);
     return false;
   }
   if (!sampler.sink_error.empty()) {  // a file that cannot be written: exit code 4 (docs/errors.md)

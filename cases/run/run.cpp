@@ -61,18 +61,31 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
 
 // Redundant constraint equations, found at a configuration that satisfies the constraints
 // (a regularized projection of the guess), then removed (a new System) or reported as an error.
-std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& opt, json& summary) {
+// The choice is one that stays valid as the mechanism moves (choose_independent_equations: a
+// cut's point rows in a frame of its body); summary.json says what was set aside and when.
+std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& opt, json& summary,
+                                                   std::shared_ptr<const System>* all_equations) {
   auto sys = std::make_shared<const System>(build_system(scene.model));
+  if (all_equations) *all_equations = sys;
   describe_system(*sys, summary);
   std::vector<double> qc = sys->q0;
   AugmentedSolver projector(*sys);
   projector.positions(qc.data(), 0.0, 1e-12, 100, 1e-10);
   const bool remove = scene.redundant_constraints != "fail";
-  const RedundancyReport rr = find_redundant_constraints(*sys, qc.data(), 0.0);
+  EquationChoice choice;
+  if (scene.redundant_constraints == "remove_world") {
+    choice.report = find_redundant_constraints(*sys, qc.data(), 0.0);
+    choice.system = without_redundant_constraints(*sys, choice.report);
+  } else {
+    choice = choose_independent_equations(*sys, qc.data(), 0.0);
+  }
+  const RedundancyReport& rr = choice.report;
   summary["redundant_constraints"] = {{"policy", scene.redundant_constraints},
                                       {"equations", rr.equations},
                                       {"rank", rr.rank},
-                                      {"redundant", rr.redundant}};
+                                      {"redundant", rr.redundant},
+                                      {"set_aside", {{{"t", 0.0}, {"equations", rr.redundant}}}},
+                                      {"in_body_frame", choice.reexpressed}};
   if (!rr.redundant.empty()) {
     std::string list;
     for (const auto& r : rr.redundant) list += "\n  " + r;
@@ -82,25 +95,32 @@ std::shared_ptr<const System> build_checked_system(const Scene& scene, const Run
     if (opt.verbose)
       std::fprintf(stderr, "mbdae: removed %zu redundant constraint equations:%s\n", rr.redundant.size(),
                    list.c_str());
-    sys = std::make_shared<const System>(without_redundant_constraints(*sys, rr));
+    sys = std::make_shared<const System>(std::move(choice.system));
   }
   summary["constraint_equations"] = sys->num_constraint_rows();
   return sys;
 }
 
+// The sensors written as columns: all, or the scene's `output` list.
+std::vector<int> column_sensors(const Scene& scene, const System& sys) {
+  std::vector<int> out;
+  if (scene.columns.empty()) {
+    for (size_t k = 0; k < sys.sensors.size(); ++k) out.push_back(static_cast<int>(k));
+    return out;
+  }
+  for (const auto& name : scene.columns) {
+    int idx = -1;
+    for (size_t k = 0; k < sys.sensors.size(); ++k)
+      if (sys.sensors[k].name == name) idx = static_cast<int>(k);
+    if (idx < 0) throw ModelError(scene.file, 0, "output", "no sensor named '" + name + "'");
+    out.push_back(idx);
+  }
+  return out;
+}
+
 void output_columns(RunContext& c) {
   const System& sys = *c.system;
-  if (c.scene.columns.empty()) {
-    for (size_t k = 0; k < sys.sensors.size(); ++k) c.column_sensors.push_back(static_cast<int>(k));
-  } else {
-    for (const auto& name : c.scene.columns) {
-      int idx = -1;
-      for (size_t k = 0; k < sys.sensors.size(); ++k)
-        if (sys.sensors[k].name == name) idx = static_cast<int>(k);
-      if (idx < 0) throw ModelError(c.scene.file, 0, "output", "no sensor named '" + name + "'");
-      c.column_sensors.push_back(idx);
-    }
-  }
+  c.column_sensors = column_sensors(c.scene, sys);
   c.result.columns = {"t"};
   c.result.units = {"s"};
   for (int k : c.column_sensors) {
@@ -150,6 +170,13 @@ void output_failed(RunContext& c, const std::string& message) {
   c.result.summary["status"] = c.result.status = "output_failed";
   c.result.summary["message"] = c.result.message = message;
   c.result.exit_code = 4;
+}
+
+std::vector<std::pair<std::string, std::string>> output_columns(const Scene& scene) {
+  const System sys = build_system(scene.model);
+  std::vector<std::pair<std::string, std::string>> out = {{"t", "s"}};
+  for (int k : column_sensors(scene, sys)) out.emplace_back(sys.sensors[k].name, sensor_unit(sys, sys.sensors[k]));
+  return out;
 }
 
 std::vector<std::string> formulations() {
@@ -206,7 +233,9 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
   summary["scene"] = scene.file;
   summary["model"] = scene.model.name;
   summary["status"] = "running";
-  RunContext c{scene, options, sinks, result, build_checked_system(scene, options, summary), {}, {}};
+  std::shared_ptr<const System> all_equations;
+  RunContext c{scene, options, sinks, result, build_checked_system(scene, options, summary, &all_equations),
+               all_equations, {}, {}};
   c.q = c.system->q0;
   output_columns(c);
   const int last = options.analysis >= 0 ? options.analysis : static_cast<int>(scene.steps.size()) - 1;

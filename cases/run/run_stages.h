@@ -27,6 +27,7 @@ struct RunContext {
   const std::vector<Sink*>& sinks;
   Result& result;
   std::shared_ptr<const System> system;  // replaced (never changed) by the stages
+  std::shared_ptr<const System> all_equations;  // as built, before redundant equations were set aside
   std::vector<double> q;                 // current positions
   std::vector<int> column_sensors;       // sensor index of each Result column after "t"
   nlohmann::ordered_json steps = nlohmann::ordered_json::array();
@@ -37,7 +38,8 @@ struct RunContext {
 };
 
 std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& options,
-                                                   nlohmann::ordered_json& summary);
+                                                   nlohmann::ordered_json& summary,
+                                                   std::shared_ptr<const System>* all_equations = nullptr);
 void output_columns(RunContext& c);
 bool assembly_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js);
 bool equilibrium_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js);

@@ -156,8 +156,14 @@ AnalysisStep Loader::step(const YAML::Node& n) {
 
 // The `animation` section (cases/output/animation_spec.h), from the model file or the scene.
 void Loader::animation(const YAML::Node& n, AnimationSpec& a) {
-  if (!check_keys(n, "animation", {"write", "frame_rate", "max_frames", "start", "end", "axis_length", "shapes"}))
+  if (!check_keys(n, "animation", {"write", "frame_rate", "max_frames", "disk_budget_mb", "format", "start", "end",
+                                   "axis_length", "shapes"}))
     return;
+  a.section = where(n);
+  const std::pair<const char*, SourceLocation*> located[] = {
+      {"frame_rate", &a.frame_rate_at}, {"max_frames", &a.max_frames_at}, {"disk_budget_mb", &a.disk_budget_at}};
+  for (const auto& [key, loc] : located)
+    if (has(n, key)) *loc = where(n[key]);
   flag(n, "write", a.write);
   auto positive = [&](const char* key, double& x, bool zero_ok) {
     const auto v = opt_number(n, key);
@@ -167,8 +173,18 @@ void Loader::animation(const YAML::Node& n, AnimationSpec& a) {
   positive("frame_rate", a.frame_rate, false);
   positive("axis_length", a.axis_length, true);
   if (const auto m = opt_number(n, "max_frames")) {
-    if (*m >= 2 && *m <= 1e7 && std::floor(*m) == *m) a.max_frames = static_cast<int>(*m);
-    else error(n["max_frames"], "max_frames", "expected a whole number from 2 to 1e7, got " + format_number(*m));
+    if (*m >= 2 && *m <= kMaxAnimationFrames && std::floor(*m) == *m) a.max_frames = static_cast<int>(*m);
+    else error(n["max_frames"], "max_frames", "expected a whole number from 2 to 1e5, got " + format_number(*m));
+  }
+  if (const auto b = opt_number(n, "disk_budget_mb")) {
+    if (*b >= 1 && *b <= 1e6) a.disk_budget_mb = *b;
+    else error(n["disk_budget_mb"], "disk_budget_mb", "expected megabytes from 1 to 1e6, got " + format_number(*b));
+  }
+  if (has(n, "format")) {
+    const std::string f = text(n, "format", "", true);
+    if (f == "binary") a.format = VtkFormat::kBinary;
+    else if (f == "ascii") a.format = VtkFormat::kAscii;
+    else error(n["format"], "format", "expected binary or ascii, got " + quote(f));
   }
   a.start = opt_number(n, "start").value_or(a.start);
   a.end = opt_number(n, "end").value_or(a.end);

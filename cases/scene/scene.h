@@ -51,12 +51,22 @@ struct AnalysisStep {
 
 struct SceneSource;  // cases/scene/scene_source.h: the texts it was read from, and its overrides
 
+// One parameter of a scene as `mbdae params` lists it (cases/scene_overrides.h): the path
+// set_parameter takes, its value as YAML text, its SI unit ("" if none or not known) and the
+// file and line where the value is written.
+struct ParameterEntry {
+  std::string path, value, unit, file;
+  int line = 0;
+};
+
 struct Scene {
   std::string file;
   Model model;
   std::vector<AnalysisStep> steps;
   std::vector<std::string> columns;  // sensors written to results.csv (empty: all)
-  std::string redundant_constraints = "remove";  // or "fail"
+  // "remove", "fail", or "remove_world" (the world components chosen at t = 0, the choice before
+  // issue 23, which degrades where a loop's plane turns: for comparison)
+  std::string redundant_constraints = "remove";
   AnimationSpec animation;  // cases/output/animation_spec.h
   // What the scene was read from (null for a scene built in code), for set_parameter.
   std::shared_ptr<const SceneSource> source;
@@ -75,5 +85,8 @@ Scene load_scene_text(const std::string& text, const std::string& path);
 // The scene read again from its source with `overrides` (parameter path, YAML value) added to
 // the ones it has (cases/mbdae.h set_parameter). Throws SceneError as load_scene does.
 Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, std::string>>& overrides);
+// Every parameter path of the scene with its value and unit (cases/scene_overrides.h), its
+// overrides applied: the paths reload_scene / set_parameter take.
+std::vector<ParameterEntry> scene_parameters(const Scene& scene);
 
 }  // namespace mbdae

@@ -118,9 +118,10 @@ void scene_options(Loader& l, const YAML::Node& root, Scene& scene, std::vector<
   scene.columns = l.names(root, "output");
   if (root["redundant_constraints"]) {
     scene.redundant_constraints = l.text(root, "redundant_constraints", "remove");
-    if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail")
+    if (scene.redundant_constraints != "remove" && scene.redundant_constraints != "fail" &&
+        scene.redundant_constraints != "remove_world")
       l.error(root["redundant_constraints"], "redundant_constraints",
-              "expected remove or fail, got '" + scene.redundant_constraints + "'");
+              "expected remove, fail or remove_world, got '" + scene.redundant_constraints + "'");
   }
 }
 
@@ -214,6 +215,23 @@ Scene reload_scene(const Scene& scene, const std::vector<std::pair<std::string, 
   SceneSource src = *scene.source;
   src.overrides.insert(src.overrides.end(), overrides.begin(), overrides.end());
   return load_source(std::move(src));
+}
+
+std::vector<ParameterEntry> scene_parameters(const Scene& scene) {
+  if (!scene.source)
+    throw SceneError({ModelError::format(scene.file, 0, "", "this scene was not loaded from YAML; it has no parameters")});
+  SceneSource src = *scene.source;
+  std::vector<SceneIssue> issues;
+  FieldLines lines;
+  const auto parsed = parse(src.text, src.path, issues);
+  if (!parsed || !parsed->IsMap()) throw SceneError(messages(issues));
+  YAML::Node root = *parsed;
+  Loader l{src.path, &issues, &lines};
+  std::optional<YAML::Node> mroot;
+  std::string model_path;
+  if (l.has(root, "model")) read_model_tree(src, l, root, issues, mroot, model_path);
+  for (const auto& [p, v] : src.overrides) apply_override(root, src.path, mroot ? &*mroot : nullptr, model_path, p, v);
+  return list_parameters(root, src.path, mroot ? &*mroot : nullptr, model_path);
 }
 
 Scene load_scene(const std::string& path) {

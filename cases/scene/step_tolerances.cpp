@@ -8,15 +8,22 @@ StepTolerances step_tolerances(const System& sys, const double* q, const Analysi
   t.scales = model_scales(sys, q, step.t0, step.t_end);
   if (step.length_scale > 0) t.scales.length = step.length_scale;
   if (step.time_scale > 0) t.scales.time = t.scales.fast_time = step.time_scale;
+  // A run's rtol (--rtol, RunOptions::rtol) other than the scene's scales the absolute
+  // tolerances the scene fixes by the same ratio, unless an atol is given with it: a looser rtol
+  // then buys a quicker run also on scenes that fix atol.
+  if (atol_override <= 0 && step.rtol > 0 && rtol > 0 && rtol != step.rtol &&
+      (step.atol > 0 || step.atol_rotation > 0 || step.atol_velocity > 0))
+    t.scene_atol_factor = rtol / step.rtol;
+  const double f = t.scene_atol_factor;
   const double aq = atol_override > 0 ? atol_override
-                    : step.atol > 0   ? step.atol
+                    : step.atol > 0   ? f * step.atol
                                       : default_position_atol(t.scales, rtol);
   t.absolute = absolute_tolerances(t.scales, aq);
   if (step.atol_rotation > 0) {
-    t.absolute.rotation = step.atol_rotation;
-    t.absolute.rotation_rate = step.atol_rotation / t.scales.time;
+    t.absolute.rotation = f * step.atol_rotation;
+    t.absolute.rotation_rate = t.absolute.rotation / t.scales.time;
   }
-  if (step.atol_velocity > 0) t.absolute.velocity = step.atol_velocity;
+  if (step.atol_velocity > 0) t.absolute.velocity = f * step.atol_velocity;
   const double rate = default_baumgarte_rate(t.scales);
   t.baumgarte_alpha = step.baumgarte_alpha >= 0 ? step.baumgarte_alpha : rate;
   t.baumgarte_beta = step.baumgarte_beta >= 0 ? step.baumgarte_beta : rate;
@@ -24,13 +31,15 @@ StepTolerances step_tolerances(const System& sys, const double* q, const Analysi
 }
 
 nlohmann::ordered_json to_json(const StepTolerances& t) {
-  return {{"length_scale", t.scales.length},
-          {"time_scale", t.scales.time},
-          {"fast_time_scale", t.scales.fast_time},
-          {"atol_position", t.absolute.position},
-          {"atol_rotation", t.absolute.rotation},
-          {"atol_velocity", t.absolute.velocity},
-          {"atol_rotation_rate", t.absolute.rotation_rate}};
+  nlohmann::ordered_json j = {{"length_scale", t.scales.length},
+                              {"time_scale", t.scales.time},
+                              {"fast_time_scale", t.scales.fast_time},
+                              {"atol_position", t.absolute.position},
+                              {"atol_rotation", t.absolute.rotation},
+                              {"atol_velocity", t.absolute.velocity},
+                              {"atol_rotation_rate", t.absolute.rotation_rate}};
+  if (t.scene_atol_factor != 1.0) j["scene_atol_scaled_by"] = t.scene_atol_factor;
+  return j;
 }
 
 }  // namespace mbdae

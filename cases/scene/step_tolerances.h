@@ -13,9 +13,13 @@ struct StepTolerances {
   ModelScales scales;
   AbsoluteTolerances absolute;
   double baumgarte_alpha = 0, baumgarte_beta = 0;
+  // rtol / the scene's rtol when the run's rtol differs from the scene's and no atol is given
+  // with it: the factor applied to the scene's atol, atol_rotation and atol_velocity (else 1).
+  double scene_atol_factor = 1.0;
 };
 
-// q: the configuration the step starts from; atol_override > 0 replaces the step's atol.
+// q: the configuration the step starts from; rtol the run's; atol_override > 0 replaces the
+// step's atol (else the scene's absolute tolerances are scaled by rtol / step.rtol).
 StepTolerances step_tolerances(const System& sys, const double* q, const AnalysisStep& step, double rtol,
                                double atol_override);
 // For summary.json: the scales and the absolute tolerances used.

@@ -175,7 +175,7 @@ def test_video_has_the_frames_and_size_asked_for(dynamics, tmp_path):
     s = json.loads(probe.stdout)["streams"][0]
     assert (int(s["nb_read_frames"]), s["width"], s["height"]) == (8, 320, 240)
     n = len(video.read_pvd(pvd))
-    assert video.animate(pvd, gif, start=0.1, size=(200, 160)) == sum(1 for t, _ in video.read_pvd(pvd) if t >= 0.1) < n
+    assert video.animate(pvd, gif, start=0.1, size=(200, 160), fps=30) == sum(1 for t, _ in video.read_pvd(pvd) if t >= 0.1) < n
     from PIL import Image
     with Image.open(gif) as im:
         assert (im.n_frames, im.size) == (sum(1 for t, _ in video.read_pvd(pvd) if t >= 0.1), (200, 160))
@@ -208,3 +208,202 @@ def test_interrupted_run_leaves_a_valid_collection(tmp_path):
     for _, path in entries[-2:]:
         assert video.read_frame(path)["points"].shape[0] > 0
     assert not list((out / "animation").glob("*.tmp"))
+
+
+def test_frames_are_compressed_binary_and_ascii_on_request_gives_the_same_numbers(dynamics, tmp_path):
+    first = dynamics / "animation" / "frame_000000.vtp"
+    head = first.read_bytes()[:4000]
+    assert b'compressor="vtkZLibDataCompressor"' in head and b'format="appended"' in head
+    assert b'format="ascii"' not in head and b'<AppendedData encoding="raw">' in first.read_bytes()
+    out, _ = run(tmp_path, scene_text(0.305, "animation: {format: ascii}"), "--animation")
+    text = (out / "animation" / "frame_000000.vtp").read_bytes()
+    assert b'format="ascii"' in text and b"appended" not in text and b"compressor" not in text
+    binary, ascii_ = video.read_pvd(dynamics / "animation.pvd"), video.read_pvd(out / "animation.pvd")
+    assert [t for t, _ in binary] == [t for t, _ in ascii_]
+    for (_, b), (_, a) in zip(binary, ascii_):  # both exact: the same doubles
+        fb, fa = video.read_frame(b), video.read_frame(a)
+        assert np.array_equal(fb["points"], fa["points"]) and np.array_equal(fb["force_vector"], fa["force_vector"])
+        for section in ("verts", "lines", "polys"):
+            for key in ("part", "body", "index", "axis", "force"):
+                assert np.array_equal(fb[section][key], fa[section][key])
+        assert fb["names"] == fa["names"]
+    size = sum(os.path.getsize(f) for _, f in binary), sum(os.path.getsize(f) for _, f in ascii_)
+    assert size[0] < 0.6 * size[1], size
+
+
+def test_every_frame_names_its_bodies_joints_and_forces(dynamics):
+    legend = json.load(open(dynamics / "animation" / "legend.json"))
+    for _, path in video.read_pvd(dynamics / "animation.pvd"):
+        names = video.read_frame(path)["names"]
+        assert names["body_names"] == [b["name"] for b in legend["bodies"]]
+        assert names["joint_names"] == legend["joints"] and names["cut_names"] == legend["cuts"]
+        assert names["force_names"] == legend["forces"] and "suspension" in names["force_names"]
+        assert names["part_names"] == [legend["parts"][str(k)] for k in range(len(legend["parts"]))]
+
+
+def test_max_frames_above_the_maximum_is_an_error_naming_the_line(tmp_path):
+    _, p = run(tmp_path, scene_text(0.1, "animation:\n  max_frames: 1e7"), "--animation", expect=2)
+    assert "scene.yaml:" in p.stderr and "field 'max_frames'" in p.stderr and "2 to 1e5" in p.stderr, p.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_animation_over_its_disk_budget_is_refused_before_the_run(tmp_path):
+    # 1e5 frames of the suspension: over the default budget of 1000 MB. Nothing is written.
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "summary.json").write_text("{}")  # an earlier run's: kept
+    text = scene_text(100, "animation:\n  frame_rate: 1000\n  max_frames: 100000")
+    _, p = run(tmp_path, text, "--animation", expect=2)
+    line = text.splitlines().index("  max_frames: 100000") + 1
+    assert f"scene.yaml:{line}: field 'max_frames'" in p.stderr and "disk budget of 1 GB" in p.stderr, p.stderr
+    assert sorted(os.listdir(tmp_path / "out")) == ["summary.json"]
+    # A frame rate that sets the count is named instead; so is the option.
+    _, p = run(tmp_path, scene_text(100, "animation:\n  frame_rate: 10\n  disk_budget_mb: 1"), "--animation", expect=2)
+    assert "field 'frame_rate'" in p.stderr and "disk budget of 1 MB" in p.stderr, p.stderr
+    _, p = run(tmp_path, scene_text(100, "animation:\n  disk_budget_mb: 1"), "--animation-rate", "10", expect=2)
+    assert "field '--animation-rate'" in p.stderr, p.stderr
+    _, p = run(tmp_path, scene_text(0.1, "animation:\n  disk_budget_mb: 0.5"), "--animation", expect=2)
+    assert "field 'disk_budget_mb'" in p.stderr and "from 1 to 1e6" in p.stderr, p.stderr
+
+
+def test_animation_larger_than_the_free_space_is_refused_before_the_run(tmp_path):
+    # Shapes make a frame large: 600 spheres (114 points each), about 10 MB a frame, in 2e4
+    # frames are about 0.2 TB, within the budget of 1 TB and more than the free space of the
+    # disk (checked with statvfs, exit code 4).
+    import shutil
+    if shutil.disk_usage(tmp_path).free > 1.5e11:
+        pytest.skip("more than 150 GB free: the scene would fit")
+    shapes = "".join(f"    - {{body: wheel, type: sphere, radius: 0.01, center: [0, 0, {k * 1e-3}]}}\n"
+                     for k in range(600))
+    text = scene_text(100, f"animation:\n  frame_rate: 1000\n  max_frames: 20000\n  disk_budget_mb: 1e6\n"
+                            f"  shapes:\n{shapes}")
+    _, p = run(tmp_path, text, "--animation", expect=4)
+    assert "free on its file system" in p.stderr and "output folder" in p.stderr, p.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unusable_folder_is_the_same_input_error_with_animation(tmp_path):
+    # /proc has no blocks (statvfs: 0 free): the folder check names the folder, exit 2, as without.
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(scene_text(0.05))
+    for args in ([], ["--animation"]):
+        p = subprocess.run([MBDAE, "run", str(scene), "--out", "/proc/mbdae_x", "--quiet", *args],
+                           capture_output=True, text=True)
+        assert p.returncode == 2 and "field '--out'" in p.stderr and "cannot be created" in p.stderr, p.stderr
+
+
+def test_a_run_without_animation_removes_the_earlier_runs_frames(tmp_path):
+    out, _ = run(tmp_path, scene_text(0.8), "--animation-rate", "1000")  # a .pvd over 64 kB
+    assert (out / "animation.pvd").stat().st_size > 65536 and list((out / "animation").glob("frame_*.vtp"))
+    (out / "animation" / "notes.txt").write_text("mine")  # not mbdae's: stays
+    (out / "animation" / "frame_000001.vtp.tmp").write_text("")  # left by a killed run
+    run(tmp_path, scene_text(0.05))
+    assert not (out / "animation.pvd").exists()
+    assert sorted(os.listdir(out / "animation")) == ["notes.txt"]
+    (out / "animation" / "notes.txt").unlink()
+    run(tmp_path, scene_text(0.05), "--animation")
+    run(tmp_path, scene_text(0.05))
+    assert not (out / "animation").exists() and not (out / "animation.pvd").exists()
+    (out / "animation.pvd").write_text("<my own collection/>")  # a .pvd mbdae did not write stays
+    run(tmp_path, scene_text(0.05))
+    assert (out / "animation.pvd").read_text() == "<my own collection/>"
+
+
+def test_gif_frame_delays_follow_the_frame_rate(dynamics, tmp_path):
+    from PIL import Image
+
+    def delays(path):
+        with Image.open(path) as im:
+            out = []
+            for k in range(im.n_frames):
+                im.seek(k)
+                out.append(im.info["duration"])
+            return out
+
+    pvd = str(dynamics / "animation.pvd")
+    times = [t for t, _ in video.read_pvd(pvd)]
+    # 20 frames per second of video: 5 cs each.
+    assert video.animate(pvd, str(tmp_path / "a.gif"), fps=20, max_frames=6, size=(80, 60)) == 6
+    assert delays(tmp_path / "a.gif") == [50] * 6
+    # Real time: the frames are 60 per simulated second, over the 50 a GIF can show: every second
+    # frame at 30 per second, delays of 3 and 4 cs that keep the time of every frame.
+    n = video.animate(pvd, str(tmp_path / "b.gif"), end=0.2, size=(80, 60))
+    d = delays(tmp_path / "b.gif")
+    assert n == len(d) == len([t for t in times if t <= 0.2][::2]) and set(d) == {30, 40}
+    assert all(abs(sum(d[:k]) - 1000 * k / 30) <= 5 for k in range(n + 1))
+    with pytest.raises(ValueError, match="at most 50 frames per second"):
+        video.animate(pvd, str(tmp_path / "c.gif"), fps=60)
+    assert video.gif_delays(4, 50) == [20] * 4 and video.gif_delays(3, 7) == [140, 150, 140]
+    for bad in (0, -1, float("nan"), float("inf")):
+        with pytest.raises(ValueError):
+            video.animate(pvd, str(tmp_path / "d.mp4"), fps=bad)
+
+
+def test_interrupted_run_lists_every_frame_it_wrote(tmp_path):
+    import signal
+    import time
+    import xml.etree.ElementTree as ET
+    scene = os.path.join(ROOT, "cases", "five_point_suspension", "dynamics_poster.yaml")
+    out = tmp_path / "out"
+    p = subprocess.Popen([MBDAE, "run", scene, "--out", str(out), "--quiet", "--animation"], stderr=subprocess.PIPE)
+    time.sleep(1.5)
+    p.send_signal(signal.SIGINT)
+    p.communicate(timeout=60)
+    assert p.returncode == 130
+    root = ET.parse(out / "animation.pvd").getroot()  # whole XML
+    listed = sorted(d.get("file") for d in root.iter("DataSet"))
+    on_disk = sorted("animation/" + f.name for f in (out / "animation").glob("frame_*.vtp"))
+    assert listed == on_disk and len(listed) > 1
+
+
+def test_the_paraview_recipe_works_as_written(dynamics):
+    # docs/animation.md's steps in ParaView's own Python (cases/animation/paraview_recipe.py).
+    # MBDAE_PVPYTHON: the command that runs ParaView's Python (docs/animation.md: Debian 12's
+    # python3-paraview conflicts with python3-vtk9, which these tests need), else pvpython.
+    import shlex
+    import shutil
+    pvpython = shlex.split(os.environ.get("MBDAE_PVPYTHON", "")) or [shutil.which("pvpython")]
+    if pvpython[0] is None:
+        pytest.skip("ParaView's pvpython is not installed (set MBDAE_PVPYTHON, docs/animation.md)")
+    t = 0.1
+    p = subprocess.run([*pvpython, os.path.join(ROOT, "cases", "animation", "paraview_recipe.py"),
+                        str(dynamics / "animation.pvd"), "--time", str(t)], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    r = json.loads(p.stdout.strip().splitlines()[-1])
+    assert r["times"] == [t for t, _ in video.read_pvd(dynamics / "animation.pvd")]
+    legend = json.load(open(dynamics / "animation" / "legend.json"))
+    assert r["reader"]["field_data"]["body_names"] == [b["name"] for b in legend["bodies"]]
+    # The spring as a tube: Threshold part 5, Extract Surface, Tube around the drawn spring line
+    # (the frame read at the time ParaView shows: the last frame at or before t).
+    frame_t, path = [e for e in video.read_pvd(dynamics / "animation.pvd") if e[0] <= t + 1e-12][-1]
+    frame = video.read_frame(path)
+    lines = frame["lines"]
+    k = [k for k in range(len(lines["ids"])) if lines["part"][k] == video.FORCE_LINE][0]
+    a, b = frame["points"][lines["ids"][k]]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    box = np.array(r["springs"]["bounds"]).reshape(3, 2)
+    assert r["springs"]["class"] == "vtkPolyData" and r["springs"]["cells"] > 0
+    assert np.all(box[:, 0] <= lo + 1e-6) and np.all(box[:, 1] >= hi - 1e-6)
+    assert np.all(box[:, 0] >= lo - 0.005 - 1e-6) and np.all(box[:, 1] <= hi + 0.005 + 1e-6)
+    assert r["arrows"]["cells"] > 0 and r["joints"]["cells"] > 0 and r["shapes"]["cells"] == 34
+    assert r["tubes"]["cells"] > 0
+
+
+def test_killed_run_leaves_a_whole_collection_of_written_frames(tmp_path):
+    # SIGKILL cannot be caught: the .pvd, appended a line at a time after each frame is renamed
+    # into place, still parses and lists only frames that are on disk (at most the last one
+    # written is not listed yet).
+    import signal
+    import time
+    import xml.etree.ElementTree as ET
+    scene = os.path.join(ROOT, "cases", "five_point_suspension", "dynamics_poster.yaml")
+    out = tmp_path / "out"
+    p = subprocess.Popen([MBDAE, "run", scene, "--out", str(out), "--quiet", "--animation"], stderr=subprocess.PIPE)
+    time.sleep(1.5)
+    p.send_signal(signal.SIGKILL)
+    p.communicate(timeout=60)
+    root = ET.parse(out / "animation.pvd").getroot()
+    listed = [d.get("file") for d in root.iter("DataSet")]
+    on_disk = sorted("animation/" + f.name for f in (out / "animation").glob("frame_*.vtp"))
+    assert len(listed) > 1 and set(listed) <= set(on_disk) and len(on_disk) - len(listed) <= 1
+    for f in listed[-2:]:
+        assert video.read_frame(str(out / f))["points"].shape[0] > 0

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The Python package's cost: (1) a Python call's CPU over the CLI's own for Dynamics I
 (target: under 5 % more), (2) sweep throughput (Dynamics II runs) with 1 and 2 local Dask workers (target: 2
-workers at least 1.7 times 1 worker).
+workers at least 1.7 times 1 worker), and with 1 and 2 threads (the default since issue 26).
 
     PYTHONPATH=build/python /usr/bin/python3 verification/benchmarks/python_overhead.py [--repeat 15] [--runs 12]
 
@@ -56,6 +56,19 @@ def overhead(cli, repeat):
     print(f"  Python over CLI: {100 * (p / c - 1):+.1f} % (median), {100 * (min(pys) / min(clis) - 1):+.1f} % (min)")
 
 
+def throughput_threads(n_threads, runs):
+    with tempfile.TemporaryDirectory() as out:
+        t0 = time.perf_counter()
+        params = [{"rtol": 1e-7, "output_step": 0.001 * (1 + k % 2)} for k in range(runs)]
+        table = mbdae.sweep(mbdae.load(POSTER), params, out, workers=n_threads, progress=False)
+        wall = time.perf_counter() - t0
+    assert (table["status"] == "ok").all()
+    rate = len(table) / wall
+    print(f"sweep of {len(table)} Dynamics II runs (20 s each), {n_threads} thread(s): {wall:.2f} s wall, "
+          f"{rate:.2f} runs/s; task CPU {table['cpu_s'].sum():.2f} s, integration {table['solver_cpu_s'].sum():.2f} s")
+    return rate
+
+
 def throughput(n_workers, runs):
     from distributed import Client, LocalCluster
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
@@ -78,12 +91,21 @@ def main():
     ap.add_argument("--cli", default=str(ROOT / "build" / "mbdae"))
     ap.add_argument("--repeat", type=int, default=15)
     ap.add_argument("--runs", type=int, default=12)
+    ap.add_argument("--threads-only", action="store_true", help="only the threads' throughput")
     a = ap.parse_args()
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
+    if a.threads_only:
+        t1, t2 = throughput_threads(1, a.runs), throughput_threads(2, a.runs)
+        print(f"2 threads / 1 thread: {t2 / t1:.2f} x; load average now {os.getloadavg()[0]:.2f}")
+        return
     overhead(a.cli, a.repeat)
     r1 = throughput(1, a.runs)
     r2 = throughput(2, a.runs)
     print(f"2 workers / 1 worker: {r2 / r1:.2f} x; load average now {os.getloadavg()[0]:.2f}")
+    t1 = throughput_threads(1, a.runs)
+    t2 = throughput_threads(2, a.runs)
+    print(f"2 threads / 1 thread: {t2 / t1:.2f} x; 2 threads / 2 workers: {t2 / r2:.2f} x; "
+          f"load average now {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

@@ -3,8 +3,10 @@
 //   W_min = residual evals x c_res + Jacobian evals x c_jac + KLU factorizations x c_klu
 //           + output samples x c_out,
 // and peak memory of each analysis run as its own process (build/mbdae).
-// Usage: suspension_performance [--quick]   (prints markdown, last issue 16's target rows: then,
-// target, measured; docs/performance.md holds a run)
+// Usage: suspension_performance [--quick] [--formulation NAME]   (prints markdown, then issue 16's
+// target rows: then, target, measured, and issue 21's: CPU and steps for wheel_z within 1e-6 m
+// beside the figures before issue 21; docs/performance.md holds a run). --formulation runs the
+// ladders with that formulation instead of the scenes' (index3).
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -38,8 +40,11 @@ struct Run {
 };
 
 // no_output: one output sample at the end instead of the scene's output step.
+std::string g_formulation;  // --formulation (empty: the scene's)
+
 Run run(const std::string& scene, double rtol, double atol, bool no_output = false) {
   RunOptions o;
+  o.formulation = g_formulation;
   o.verbose = false;
   o.progress = false;
   o.rtol = rtol;
@@ -181,7 +186,16 @@ struct Analysis {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+    else if (std::strcmp(argv[i], "--formulation") == 0 && i + 1 < argc) g_formulation = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: suspension_performance [--quick] [--formulation NAME]\n");
+      return 2;
+    }
+  }
+  std::vector<std::string> best_steps;  // per analysis: steps of the cheapest run within 1e-6 m
   std::vector<std::string> best_cpus;  // per analysis, for the target rows
   const int reps = quick ? 1 : 3;
   std::vector<Analysis> analyses = {
@@ -202,6 +216,7 @@ int main(int argc, char** argv) {
     const Run check = run(an.scene, an.ref_rtol * 10, an.ref_atol * 10);
     const double ref_err = max_error(check, ref, "wheel_z");
     double best_cpu = -1, best_tol = 0;
+    long best_n = 0;
     for (double tol : an.ladder) {
       std::vector<double> cpus;
       Run r;
@@ -220,11 +235,15 @@ int main(int argc, char** argv) {
       if (err <= 1e-6 && best_cpu < 0) {
         best_cpu = cpu;
         best_tol = tol;
+        best_n = r.stats["steps"].get<long>();
       }
     }
     char best[128] = "not reached";
     if (best_cpu > 0) std::snprintf(best, sizeof best, "%.1f ms at rtol %.0e", best_cpu * 1e3, best_tol);
     best_cpus.push_back(best);
+    char steps[160] = "not reached";
+    if (best_cpu > 0) std::snprintf(steps, sizeof steps, "%.1f ms, %ld steps (rtol %.0e)", best_cpu * 1e3, best_n, best_tol);
+    best_steps.push_back(steps);
     if (an.name == "dynamics II" && best_cpu > 0) poster_rtol = best_tol;
     char line[512];
     std::snprintf(line, sizeof line, "| %s | %d | %.2f | %.2f | %.2f | %.2f | %.1f | %.2e | %s | %.1f |",
@@ -251,5 +270,13 @@ int main(int argc, char** argv) {
       {"serial chain of 1000 links, 0.05 s", "88.6 s, 539 MB", "linear in N", scaling},
       {"serial chain of 10000 links", "killed above 15.9 GB", "runs, memory linear in N", scaling},
   });
+  // Issue 21: the cheapest rung of the ladder (atol = 1e-6 rtol) with wheel_z within 1e-6 m of
+  // the reference, beside the figures before issue 21 (index3, the scenes' formulation, on a
+  // quiet machine).
+  std::printf("\n| issue 21: wheel_z within 1e-6 m (%s) | before issue 21 | target | measured |\n|---|---|---|---|\n",
+              g_formulation.empty() ? "the scenes' formulation" : g_formulation.c_str());
+  std::printf("| dynamics I, 1.5 s | 55 ms (index3) | 27.5 ms | %s |\n", best_steps[1].c_str());
+  std::printf("| dynamics II, 20 s | 1.18 s, about 27000 steps (index3); index1 17621 steps at rtol 3e-8 | 0.59 s | %s |\n",
+              quick ? "not run (--quick)" : best_steps[2].c_str());
   return 0;
 }

@@ -16,7 +16,8 @@
 //
 // Timings (CPU time of the process, clock_gettime(CLOCK_PROCESS_CPUTIME_ID)):
 //   setup      build_system, the consistent projection of the guess and the redundancy analysis
-//              (SPQR rank-revealing QR of Phi_q^T), each timed separately, as run() does it;
+//              (SPQR rank-revealing QR of Phi_q^T, twice where cut point rows are re-expressed in a
+//              body frame: choose_independent_equations), each timed separately, as run() does it;
 //   residual   each DaeProblem::residual call, by a DaeProblem wrapper around Index3Dae;
 //   jacobian   each DaeProblem::jacobian call (assembly of dF/dy + cj dF/dy'), the same way;
 //   KLU        the factorizations happen inside IDA's linear solver (core/klu_linear_solver.cpp,
@@ -254,10 +255,10 @@ Result run_one(int n, Topology topo) {
   }
   res.project_s = cpu_now() - c0;
   c0 = cpu_now();
-  const RedundancyReport rr = find_redundant_constraints(sys, q.data(), 0.0);
-  sys = without_redundant_constraints(sys, rr);
+  EquationChoice choice = choose_independent_equations(sys, q.data(), 0.0);
+  sys = std::move(choice.system);
   res.qr_s = cpu_now() - c0;
-  res.redundant = static_cast<long>(rr.redundant.size());
+  res.redundant = static_cast<long>(choice.report.redundant.size());
   res.equations = sys.num_constraint_rows();
 
   // Initial velocities as a scene's initial_velocities gives them (formulation/initial_velocities.h):

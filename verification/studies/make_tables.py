@@ -127,7 +127,7 @@ def work_precision(args):
             ", ".join(meta.get("formulations_run", [])) or "none",
             "; ".join("%s (%s)" % (k, v.split(": ")[-1]) for k, v in skipped.items()) or "none"))
         parts.append("- Ladder: rtol = tau, atol = %g tau. cpu_median: median over %d run(s) of the integration "
-                     "step's `cpu_seconds` (process CPU time, output samples included: "
+                     "step's `cpu_seconds` (CPU time of the integrating thread, output samples included: "
                      "an acceleration solve and the sensors at every sample, and a projection where the scene asks for one); cpu_no_output_median: the same runs with "
                      "samples at t0 and t_end only (their step count: steps_no_output); wall_median: wall time of the whole "
                      "scene (assembly and equilibrium included) on a shared machine." % (meta["atol_ratio"],
@@ -190,7 +190,9 @@ def promise_tables(path):
              "velocity sensor (m/s, rad/s), divided by the quantity's scale (the largest |x_ref| of the sensors of "
              "its unit; fast mechanism: of the sensor), the worst sensor named. References: index2-ggl at "
              "rtol 1e-11 (`tolerance_promise`; ref. check: its difference from rtol 1e-10), the fast mechanism's "
-             "Lagrange equation (`fast_mechanism_study`; converged to 1e-10). CPU: `cpu_seconds` of the "
+             "Lagrange equation (`fast_mechanism_study`; converged to 1e-10), the spinning top's Euler equations "
+             "(`verification/studies/promise/`: `promise_study.py`, `spinning_top_reference.py`; its rtol 1e-11 and "
+             "1e-13 solutions agree to 1.6e-11). CPU: `cpu_seconds` of the "
              "integration on a shared machine. Promise: both errors within 10 rtol. Raw data: "
              "`docs/studies/promise.csv`.", "",
              "| case | formulation | rtol | steps | residual evals | CPU [s] | position error / scale | "
@@ -368,7 +370,7 @@ def extreme_doc(args):
     lines.append("")
     lines.append("err: max |x - x_ref| over the output samples both runs have, against the run named in the last "
                  "column (the same scene at a tighter tolerance, or the spec's scene). viol_pos: max |Phi| at the "
-                 "integrator's steps. cpu: the integration step's process CPU time; wall: the whole `mbdae run` "
+                 "integrator's steps. cpu: the integration step's CPU time (its thread's clock); wall: the whole `mbdae run` "
                  "(assembly and equilibrium included) on a shared machine. Long runs (--long) keep the result of "
                  "their last run; the date of each result is in `docs/studies/extreme/NAME.json`.")
     lines.append("")

@@ -9,15 +9,16 @@
 
     table = mbdae.sweep(scene, {"forces.suspension.damping": [700, 1400, 2800]}, out="build/sweep",
                         metrics={"travel": mbdae.metrics.peak_deviation("wheel_z")})
+    scene.parameters()   # every parameter path with its value and unit
 
 See docs/python.md."""
 from . import metrics
-from ._core import formulations
+from ._core import __version__, formulations
 from .errors import SceneError, SolveError
 from .result import Result
 from .scene import Scene, load
-from .sweep import read_run, sweep
+from .sweep import SweepOutputError, read_run, read_sweep, runs_dataset, sweep
 from .work_precision import work_precision
 
-__all__ = ["Scene", "Result", "SceneError", "SolveError", "load", "sweep", "read_run", "work_precision",
-           "formulations", "metrics"]
+__all__ = ["Scene", "Result", "SceneError", "SolveError", "SweepOutputError", "load", "sweep", "read_run",
+           "read_sweep", "runs_dataset", "work_precision", "formulations", "metrics", "__version__"]

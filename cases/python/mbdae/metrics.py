@@ -1,7 +1,17 @@
 """Summary metrics of a run for sweep tables: each is a function Result -> float, named by the
 caller (sweep(..., metrics={"peak_travel": peak_deviation("wheel_z")})). Any function of a
-Result works; these cover the usual ones."""
+Result works; these cover the usual ones. Each carries `columns` (what it reads: a sweep checks
+them against the scene before its first run), `spec` (its text form, what defines it when a
+sweep is resumed) and `unit` (None: its column's unit)."""
 import numpy as np
+
+
+def _named(f, kind, column, unit=None, threshold=None):
+    f.__name__ = f"{kind}({column})" if threshold is None else f"{kind}({column}, {threshold:g})"
+    f.columns = (column,)
+    f.spec = f"{kind}:{column}" + ("" if threshold is None else f":{threshold!r}")
+    f.unit = unit
+    return f
 
 
 def peak_deviation(column):
@@ -10,8 +20,7 @@ def peak_deviation(column):
     def f(r):
         x = r[column]
         return float(np.max(np.abs(x - x[0]))) if len(x) else float("nan")
-    f.__name__ = f"peak_deviation({column})"
-    return f
+    return _named(f, "peak_deviation", column)
 
 
 def peak(column):
@@ -19,8 +28,7 @@ def peak(column):
     def f(r):
         x = r[column]
         return float(np.max(np.abs(x))) if len(x) else float("nan")
-    f.__name__ = f"peak({column})"
-    return f
+    return _named(f, "peak", column)
 
 
 def rms(column):
@@ -28,8 +36,7 @@ def rms(column):
     def f(r):
         x = r[column]
         return float(np.sqrt(np.mean(np.square(x)))) if len(x) else float("nan")
-    f.__name__ = f"rms({column})"
-    return f
+    return _named(f, "rms", column)
 
 
 def first_time_at_or_below(column, threshold=0.0):
@@ -38,8 +45,7 @@ def first_time_at_or_below(column, threshold=0.0):
     def f(r):
         hit = np.flatnonzero(r[column] <= threshold)
         return float(r["t"][hit[0]]) if len(hit) else float("nan")
-    f.__name__ = f"first_time_at_or_below({column}, {threshold:g})"
-    return f
+    return _named(f, "first_time_at_or_below", column, "s", threshold)
 
 
 def time_at_or_below(column, threshold=0.0):
@@ -50,8 +56,7 @@ def time_at_or_below(column, threshold=0.0):
         if len(t) < 2:
             return 0.0
         return float(np.sum(np.diff(t)[x[:-1] <= threshold]))
-    f.__name__ = f"time_at_or_below({column}, {threshold:g})"
-    return f
+    return _named(f, "time_at_or_below", column, "s", threshold)
 
 
 def from_spec(spec):
@@ -63,3 +68,12 @@ def from_spec(spec):
     if parts[0] not in kinds or len(parts) not in (2, 3):
         raise ValueError(f"metric '{spec}': expected KIND:COLUMN[:THRESHOLD], KIND one of {', '.join(kinds)}")
     return kinds[parts[0]](parts[1], *(float(p) for p in parts[2:]))
+
+
+def unit_of(f, column_units):
+    """The unit of a metric's values: its `unit`, else its column's, else ""."""
+    unit = getattr(f, "unit", None)
+    if unit is not None:
+        return unit
+    cols = getattr(f, "columns", ())
+    return column_units.get(cols[0], "") if len(cols) == 1 else ""

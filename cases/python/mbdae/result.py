@@ -62,11 +62,23 @@ class Result:
         return self._summary
 
     def cpu_seconds(self):
-        """The integration steps' CPU time (sum of the steps' statistics.cpu_seconds)."""
+        """The integration steps' CPU time (sum of the steps' statistics.cpu_seconds): the clock of
+        the thread that solved them, so runs in parallel threads each report their own cost."""
         return sum(s.get("statistics", {}).get("cpu_seconds", 0.0) for s in self.summary.get("steps", []))
 
     def __repr__(self):
         return f"<mbdae.Result {self.status}: {self.rows} rows x {len(self.names)} columns>"
+
+    def _repr_html_(self):
+        from html import escape
+        steps = self.summary.get("steps", [])
+        nsteps = sum(s.get("statistics", {}).get("steps", 0) for s in steps)
+        est = self.summary.get("error_estimate")
+        cols = ", ".join(f"{escape(n)} [{escape(u)}]" for n, u in zip(self.names, self.units))
+        msg = f" ({escape(self.message)})" if self.message else ""
+        extra = f"<br>error estimate: {escape(json.dumps(est))}" if est else ""
+        return (f"<p><b>mbdae.Result</b> {escape(self.status)}{msg}<br>{self.rows} rows; {nsteps} integration "
+                f"steps; CPU {self.cpu_seconds():.3g} s{extra}<br>columns: {cols}</p>")
 
     def __reduce__(self):  # pickles as plain arrays (Dask, multiprocessing)
         return (Result, (self.status, self.message, self.names, [np.array(a) for a in self._arrays], self.units,

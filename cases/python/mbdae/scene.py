@@ -2,6 +2,9 @@
 import json
 import math
 import os
+import shutil
+import tempfile
+import weakref
 
 from . import _core
 from .errors import SceneError, SolveError
@@ -14,6 +17,17 @@ def _scene_errors(call, *args):
         return call(*args)
     except _core.SceneErrorLines as e:
         raise SceneError(e.args[0]) from None
+
+
+class _TemporaryFolder:
+    """The folder of run(animation=True) without `out`: a new temporary folder, removed by
+    remove() (when its Result is collected, or at exit)."""
+
+    def __init__(self):
+        self.path = tempfile.mkdtemp(prefix="mbdae_animation_")
+
+    def remove(self):
+        shutil.rmtree(self.path, ignore_errors=True)
 
 
 def yaml_value(value):
@@ -109,23 +123,32 @@ class Scene:
         """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
         override the scene's when given; `analysis` (an index or a step type such as "dynamics")
         stops after that step; `out` also writes results.csv and summary.json there. `animation`
-        (a folder, or True for `out` or a new temporary folder) also writes the run as a ParaView
-        time series (animation.pvd, docs/animation.md) that Result.animation() draws as a video;
+        (a folder, or True for `out` or a new temporary folder, removed with the Result or at
+        exit) also writes the run as a ParaView time series (animation.pvd, docs/animation.md)
+        that Result.animation() draws as a video;
         `animation_rate` sets its frames per second of simulated time. Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis)
         if out is not None:
             opt.out_dir = str(out)
+        temporary = None
         if animation is True:
-            import tempfile
-            animation = out if out is not None else tempfile.mkdtemp(prefix="mbdae_animation_")
+            temporary = None if out is not None else _TemporaryFolder()
+            animation = out if out is not None else temporary.path
         if animation:
             opt.animation_dir = str(animation)
-        if animation_rate is not None:
-            opt.animation_rate = _positive("animation_rate", animation_rate)
-        result = Result._from_core(_scene_errors(_core.run, self._core, opt))
+        try:
+            if animation_rate is not None:
+                opt.animation_rate = _positive("animation_rate", animation_rate)
+            result = Result._from_core(_scene_errors(_core.run, self._core, opt))
+        except BaseException:
+            if temporary:
+                temporary.remove()
+            raise
         result.animation_dir = opt.animation_dir or None
+        if temporary:  # removed with the Result (or at exit), not left behind in the temp folder
+            weakref.finalize(result, temporary.remove)
         if opt.analysis >= 0 and len(result.summary.get("steps", [])) > opt.analysis + 1:
             raise NotImplementedError("run(analysis=...): this build's mbdae::run ignores RunOptions::analysis")
         if raise_on_failure and not result.ok:
@@ -157,6 +180,25 @@ class Scene:
 
     def __reduce__(self):
         return (_rebuild, (self._path, self._text, self.overrides))
+
+    # ---- Inspection -------------------------------------------------------------------------
+    def parameters(self):
+        """Every parameter path of the scene (and its model file) with its current value (YAML
+        text) and unit, from the resolver set() uses: [{"path", "value", "unit", "file", "line"}].
+        The same list as `mbdae params SCENE`."""
+        return [dict(p) for p in _scene_errors(_core.parameters, self._core)]
+
+    def output_columns(self):
+        """[(name, unit)] of the columns a run writes ("t", then the output sensors), without
+        running (the model is built)."""
+        return [tuple(c) for c in _scene_errors(_core.output_columns, self._core)]
+
+    def _repr_html_(self):
+        from html import escape
+        cols = ", ".join(f"{escape(n)} [{escape(u)}]" for n, u in self.output_columns())
+        over = "".join(f"<li>{escape(p)} = {escape(v)}</li>" for p, v in self.overrides)
+        return (f"<p><b>mbdae.Scene</b> {escape(str(self.file))}<br>steps: {escape(', '.join(self.steps))}<br>"
+                f"columns: {cols}</p>" + (f"<p>overrides:</p><ul>{over}</ul>" if over else ""))
 
 
 def _rebuild(path, text, overrides):

@@ -1,13 +1,11 @@
-"""Parameter sweeps on Dask: one task per run, one result file per run, one table of all runs.
+"""Parameter sweeps: one task per run, one result file per run, one table of all runs.
 
-Where things run: the client (the caller's process) expands the grid, skips the runs already
-done in `out`, submits one task per remaining run and writes every file; each task (on a Dask
-worker, this machine's LocalCluster by default) re-reads the scene, applies its overrides, runs
-it, computes the metrics and sends back its row and its columns. See docs/python.md."""
-import contextlib
-import hashlib
+Where things run: the caller checks every parameter path and metric column against the scene,
+takes the folder's lock, expands the grid, reuses the runs already finished in `out` (files
+verified), submits one task per remaining run (to threads of this process by default, or to
+Dask) and writes every file; each task applies its overrides to the scene, runs it, computes
+the metrics and returns its row and its columns. See docs/python.md."""
 import itertools
-import json
 import os
 import socket
 import sys
@@ -17,13 +15,16 @@ from pathlib import Path
 
 import numpy as np
 
+from . import metrics as _metrics
 from .errors import SceneError
+from .sweep_backends import backend
+from .sweep_checks import (RUN_OPTIONS, check_metrics, check_options, check_parameters, check_workers,
+                           metric_fingerprint, plain, run_key, scene_key)
+from .sweep_files import (FolderLock, SweepOutputError, finished_row, read_h5, read_json, record, write_json)
+from .sweep_table import make_table, read_run, read_sweep, runs_dataset  # noqa: F401 -- re-exported
 
-# Sweep keys that are run options (as scene.run's arguments), not scene parameter paths.
-RUN_OPTIONS = ("rtol", "atol", "formulation", "output_step", "analysis")
-# Statuses of runs that did not complete for reasons outside the run (a lost worker, a task
-# error): a later sweep into the same folder runs them again.
-RETRY_STATUSES = ("lost",)
+__all__ = ["sweep", "expand", "run_one", "read_run", "read_sweep", "runs_dataset", "RUN_OPTIONS",
+           "SweepOutputError"]
 
 
 def expand(params):
@@ -37,210 +38,265 @@ def expand(params):
     return [dict(p) for p in params]
 
 
-def _plain(v):
-    return v.item() if hasattr(v, "item") else v
-
-
-def run_key(scene, run, options):
-    """A hash naming a run's inputs (scene source and overrides, parameters, options): a folder's
-    finished run is reused only by a run with the same key."""
-    text = scene._text if scene._text is not None else Path(scene._path).read_text()
-    blob = json.dumps([scene._path, text, scene.overrides, {k: _plain(v) for k, v in run.items()},
-                       {k: _plain(v) for k, v in sorted(options.items())}], default=str)
-    return hashlib.sha1(blob.encode()).hexdigest()[:16]
+def compute_metrics(result, metrics, row):
+    """The metrics of `result` into `row`; a metric that raises is NaN and the row's status
+    `metric_failed` (never `ok` over a missing value)."""
+    failed = []
+    for name, f in metrics.items():
+        try:
+            row[name] = float(f(result)) if result.rows else float("nan")
+        except Exception as e:  # noqa: BLE001 -- recorded in the row
+            row[name] = float("nan")
+            failed.append(f"metric {name}: {type(e).__name__}: {e}")
+    row["status"] = row.get("run_status", row.get("status", ""))
+    if failed:
+        row["status"] = "metric_failed"
+        row["message"] = "; ".join(([row["run_message"]] if row.get("run_message") else []) + failed)
+    else:
+        row["message"] = row.get("run_message", "")
+    return row
 
 
 def run_one(scene, run, options, metrics):
     """The task: one run with its overrides and options; never raises for a bad or failing run
-    (the row says what happened). Returns {"row": ..., "columns": {name: array}, "summary": json}."""
+    (the row says what happened). Returns {"row", "columns": {name: array}, "units", "summary"}."""
     cpu0, wall0 = time.thread_time(), time.perf_counter()
     row = {"status": "", "message": "", "worker": f"{socket.gethostname()}:{os.getpid()}"}
     overrides = [(k, v) for k, v in run.items() if k not in RUN_OPTIONS]
-    opts = dict(options, **{k: _plain(v) for k, v in run.items() if k in RUN_OPTIONS})
+    opts = dict(options, **{k: plain(v) for k, v in run.items() if k in RUN_OPTIONS})
     result = None
     try:
         result = scene.with_params(overrides).run(raise_on_failure=False, **opts)
-    except SceneError as e:
-        row.update(status="invalid", message=str(e))
-    except ValueError as e:  # a bad run option
+    except (SceneError, ValueError) as e:  # a bad override or run option
         row.update(status="invalid", message=str(e))
     except Exception as e:  # noqa: BLE001 -- recorded in the table, the sweep goes on
         row.update(status="error", message=f"{type(e).__name__}: {e}")
+    if result is not None:
+        row.update(run_status=result.status, run_message=result.message, solver_cpu_s=result.cpu_seconds(),
+                   rows=result.rows)
+        compute_metrics(result, metrics, row)
     row["cpu_s"] = time.thread_time() - cpu0
     row["wall_s"] = time.perf_counter() - wall0
     if result is None:
-        return {"row": row, "columns": None, "summary": None}
-    row.update(status=result.status, message=result.message, solver_cpu_s=result.cpu_seconds(), rows=result.rows)
-    for name, f in (metrics or {}).items():
-        try:
-            row[name] = float(f(result)) if result.rows else float("nan")
-        except Exception as e:  # noqa: BLE001
-            row[name] = float("nan")
-            row["message"] = (row["message"] + "; " if row["message"] else "") + f"metric {name}: {type(e).__name__}: {e}"
-    return {"row": row, "columns": {n: np.array(a) for n, a in result.columns.items()}, "summary": result._summary_json}
+        return {"row": row, "columns": None, "units": None, "summary": None}
+    return {"row": row, "columns": {n: np.array(a) for n, a in result.columns.items()}, "units": list(result.units),
+            "summary": result._summary_json}
 
 
-# ---- Files --------------------------------------------------------------------------------------
-def _run_name(i):
-    return f"run_{i:05d}"
+def _stored_result(out, row):
+    """A Result rebuilt from a run's stored file (to compute changed metrics without running)."""
+    from .result import Result
+    df, _, summary = read_h5(out / row["file"])
+    units = df.attrs.get("units", {})
+    names = [df.index.name or "t", *df.columns]
+    arrays = [df.index.to_numpy(), *(df[c].to_numpy() for c in df.columns)]
+    import json
+    return Result(row.get("run_status", row["status"]), row.get("run_message", ""), names, arrays,
+                  [units.get(n, "") for n in names], json.dumps(summary))
 
 
-def _write_run_file(path, columns, params, summary):
-    """One run's samples as HDF5 (pandas.read_hdf(path)), its parameters and summary.json as
-    attributes; written to a temporary name and renamed, so a file present is complete."""
-    import pandas as pd
-    tmp = path.with_suffix(".tmp")
-    with pd.HDFStore(tmp, mode="w") as store:
-        store.put("results", pd.DataFrame(columns), format="fixed")
-        attrs = store.get_storer("results").attrs
-        attrs.params = json.dumps(params, default=str)
-        attrs.summary = summary or "{}"
-    os.replace(tmp, path)
-
-
-def _write_json(path, obj):
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(obj, default=str))
-    os.replace(tmp, path)
-
-
-def _done_runs(runs_dir, keys):
-    """{index: row} of the runs finished in an earlier sweep with the same inputs."""
-    done = {}
-    for i, key in enumerate(keys):
-        p = runs_dir / (_run_name(i) + ".json")
-        if p.exists():
-            row = json.loads(p.read_text())
-            if row.get("key") == key and row.get("status") not in RETRY_STATUSES:
-                done[i] = row
-    return done
-
-
-def _record(out, i, key, run, payload):
-    """Writes run i's result file (if it has samples) then its row: the row is the mark of a
-    finished run."""
-    row = {"run": i, **{k: _plain(v) for k, v in run.items()}, **payload["row"], "key": key, "file": ""}
-    if payload.get("columns"):
-        name = Path("runs") / (_run_name(i) + ".h5")
-        _write_run_file(out / name, payload["columns"], {k: _plain(v) for k, v in run.items()}, payload["summary"])
-        row["file"] = str(name)
-    _write_json(out / "runs" / (_run_name(i) + ".json"), row)
+def _refresh_metrics(out, row, metrics, defs):
+    """A reused run whose metrics were defined otherwise: recomputed from its stored samples and
+    its row rewritten (never returned stale)."""
+    if row.get("metric_defs") == defs:
+        return row
+    for name in set(row.get("metric_defs") or {}) - set(defs):
+        row.pop(name, None)
+    if row.get("file"):
+        compute_metrics(_stored_result(out, row), metrics, row)
+    else:
+        row.update({name: float("nan") for name in metrics})
+    row["metric_defs"] = defs
+    write_json(out / "runs" / f"{row['key']}.json", row)
     return row
 
 
-def _table(out, rows, param_names, metric_names):
-    import pandas as pd
-    first = ["run", *param_names, "status", "message", "cpu_s", "solver_cpu_s", "wall_s", "rows", *metric_names]
-    df = pd.DataFrame(sorted(rows, key=lambda r: r["run"]))
-    for c in first:
-        if c not in df.columns:
-            df[c] = np.nan
-    df = df[first + [c for c in df.columns if c not in first]]
-    tmp = out / "runs.csv.tmp"
-    df.to_csv(tmp, index=False)
-    os.replace(tmp, out / "runs.csv")
-    return df
+def _manifest(out, scene, runs, keys, options, defs, extend):
+    """OUT/sweep.json: the folder's runs. A folder holding another sweep (other runs) is refused
+    unless `extend`; then its runs are kept and the new ones added after them."""
+    path = out / "sweep.json"
+    old = read_json(path) if path.exists() else None
+    entries = [{"key": k, "params": {p: plain(v) for p, v in r.items()}} for k, r in zip(keys, runs)]
+    if isinstance(old, dict) and old.get("runs"):
+        old_keys = [e["key"] for e in old["runs"]]
+        if set(old_keys) != set(keys):
+            if not extend:
+                new = sorted({p for r in runs for p in r})
+                was = sorted({p for e in old["runs"] for p in e["params"]})
+                what = (f"parameters {', '.join(was) or '(none)'}" if was != new else
+                        "other values, or another scene or options")
+                raise ValueError(f"{out}: holds another sweep ({len(old_keys)} runs, {what}); pass extend=True "
+                                 f"(--extend) to add these runs to it, or sweep into another folder")
+            known = set(old_keys)
+            entries = old["runs"] + [e for e in entries if e["key"] not in known and not known.add(e["key"])]
+    manifest = {"scene": str(scene.file), "runs": entries, "options": {k: plain(v) for k, v in options.items()},
+                "metrics": defs}
+    write_json(path, manifest)
+    return manifest
 
 
-# ---- Dask -----------------------------------------------------------------------------------------
-@contextlib.contextmanager
-def dask_client(client=None, workers=None):
-    """A distributed.Client: the one given, one connected to a scheduler address, or (None) a
-    LocalCluster of `workers` worker processes (default: one per core), one thread each."""
-    from distributed import Client, LocalCluster
-    if isinstance(client, Client):
-        yield client
-        return
-    if isinstance(client, str):
-        with Client(client) as c:
-            yield c
-        return
-    if client is not None:
-        raise TypeError(f"client: expected None, a distributed.Client or a scheduler address, got {client!r}")
-    n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as c:
-        yield c
+def _units(scene, runs, metrics):
+    """{table column: unit}: the run's own columns, the parameters' and the metrics'."""
+    column_units = dict(scene.output_columns())
+    param_units = {p["path"]: p["unit"] for p in scene.parameters()}
+    units = {"cpu_s": "s", "solver_cpu_s": "s", "wall_s": "s", "rows": "1",
+             "rtol": "1", "atol": param_units.get("analysis.dynamics.atol", "m"), "output_step": "s"}
+    for r in runs:
+        for p in r:
+            if p not in RUN_OPTIONS:
+                units.setdefault(p, param_units.get(p, ""))
+    units.update({n: _metrics.unit_of(f, column_units) for n, f in metrics.items()})
+    return units
 
 
-class _Progress:
-    """A text progress bar on stderr (redrawn in place on a terminal, every 10 % otherwise)."""
+class _Bar:
+    """The progress bar (tqdm) on stderr."""
 
     def __init__(self, total, skipped, enabled):
-        self.total, self.done, self.failed, self.skipped = total, skipped, 0, skipped
-        self.enabled, self.tty = enabled, sys.stderr.isatty()
-        self.start, self.last_tenth = time.perf_counter(), -1
-        self.draw()
+        self.bar, self.failed = None, 0
+        if enabled:
+            try:
+                from tqdm import tqdm
+            except ImportError:
+                raise ImportError("sweep progress bars need tqdm (Debian: python3-tqdm); progress=False runs "
+                                  "without one") from None
+            self.bar = tqdm(total=total, initial=skipped, desc="sweep", unit="run", file=sys.stderr,
+                            mininterval=0.5 if sys.stderr.isatty() else 30, dynamic_ncols=True)
+            self.bar.set_postfix_str(f"{skipped} done before, 0 not ok", refresh=False)
+            self.skipped = skipped
 
     def update(self, status):
-        self.done += 1
-        self.failed += status != "ok"
-        self.draw()
+        if self.bar is not None:
+            self.failed += status != "ok"
+            self.bar.set_postfix_str(f"{self.skipped} done before, {self.failed} not ok", refresh=False)
+            self.bar.update(1)
 
-    def draw(self):
-        if not self.enabled:
-            return
-        frac = self.done / self.total if self.total else 1.0
-        tenth = int(frac * 10)
-        if not self.tty and tenth == self.last_tenth and self.done < self.total:
-            return
-        self.last_tenth = tenth
-        bar = "#" * int(frac * 30) + "." * (30 - int(frac * 30))
-        line = (f"sweep [{bar}] {self.done}/{self.total} runs ({self.skipped} done before, {self.failed} not ok) "
-                f"{time.perf_counter() - self.start:.0f} s")
-        sys.stderr.write(("\r" + line) if self.tty else (line + "\n"))
-        if self.tty and self.done >= self.total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
 
 
-def sweep(scene, params, out, client=None, metrics=None, options=None, workers=None, progress=True, retries=1):
-    """Runs `scene` once per parameter set, one Dask task each, and returns the table of all runs
-    (a pandas DataFrame, also written to OUT/runs.csv).
+def sweep(scene, params, out, client=None, metrics=None, options=None, workers=None, progress=True, retries=1,
+          extend=False, worker_timeout=60.0):
+    """Runs `scene` once per parameter set and returns the table of all runs (a pandas
+    DataFrame with units in table.attrs["units"], also written to OUT/runs.csv).
 
     params: a grid {path: [values]} or a list of {path: value}; paths are scene parameters
-      (forces.suspension.damping) or run options (rtol, atol, formulation, output_step, analysis).
-    out: the folder: OUT/runs/run_NNNNN.h5 (each run's samples, pandas.read_hdf) and .json (its
-      row), OUT/runs.csv. Runs already finished there with the same inputs are not run again.
-    client: None (a LocalCluster of `workers` processes, default one per core), a
-      distributed.Client, or a scheduler address ("tcp://host:8786").
-    metrics: {column name: function(Result) -> float} (see mbdae.metrics), computed by the task.
+      (forces.suspension.damping, bodies.chassis.points.bp1.2; scene.parameters() lists them) or
+      run options (rtol, atol, formulation, output_step, analysis).
+    out: the folder (OUT/runs/KEY.h5 each run's samples, KEY.json its row, OUT/runs.csv,
+      OUT/sweep.json). Runs finished there with the same inputs are reused (files verified);
+      a folder holding other runs is refused unless extend=True (the runs are added).
+    client: None or "threads" (threads of this process, `workers` of them, default one per
+      core), "processes" (a Dask LocalCluster of `workers` processes), a distributed.Client or a
+      scheduler address ("tcp://host:8786").
+    metrics: {column name: function(Result) -> float} (see mbdae.metrics).
     options: run options for every run (rtol=..., formulation=...).
-    retries: Dask retries of a task that raised (a worker that died is retried by the scheduler
-      up to distributed.scheduler.allowed-failures times).
-    A run that is invalid or fails is a row with its status and message; the sweep goes on."""
-    from distributed import as_completed
+    retries: Dask retries of a task that raised; worker_timeout: seconds without any Dask
+      worker after which the unfinished runs are recorded `lost` and the sweep ends.
+    Before the first run every parameter path, option and metric column is checked (SceneError /
+    ValueError with suggestions). A run that is invalid or fails is a row with its status and
+    message; the sweep goes on. A folder that cannot be written raises SweepOutputError (an
+    OSError) and keeps the runs finished before whole."""
     runs, options, metrics = expand(params), dict(options or {}), dict(metrics or {})
+    check_options(options)
+    workers = check_workers(workers, client)
+    if workers is not None and client not in (None, "threads", "processes"):
+        raise ValueError("workers applies to local runs (client None, 'threads' or 'processes'), not to a given "
+                         "Dask cluster (its workers are started with it)")
+    if not (isinstance(worker_timeout, (int, float)) and worker_timeout > 0):
+        raise ValueError(f"worker_timeout expects seconds > 0, got {worker_timeout!r}")
+    check_parameters(scene, runs)
+    check_metrics(scene, metrics)
     out = Path(out)
-    (out / "runs").mkdir(parents=True, exist_ok=True)
-    keys = [run_key(scene, run, options) for run in runs]
-    rows = _done_runs(out / "runs", keys)
-    todo = [i for i in range(len(runs)) if i not in rows]
-    bar = _Progress(len(runs), len(rows), progress)
-    if todo:
-        with dask_client(client, workers) as c:
-            token = uuid.uuid4().hex[:8]
-            futures = {c.submit(run_one, scene, runs[i], options, metrics, key=f"mbdae-run-{i}-{token}",
-                                pure=False, retries=retries): i for i in todo}
-            for fut in as_completed(futures):
-                i = futures[fut]
+    try:
+        (out / "runs").mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise SweepOutputError(e.errno, f"{out}: cannot create the sweep folder: {e.strerror}") from None
+    lock = FolderLock(out)
+    try:
+        return _sweep_locked(scene, runs, out, client, metrics, options, workers, progress, retries, extend,
+                             worker_timeout)
+    finally:
+        lock.release()
+
+
+def _sweep_locked(scene, runs, out, client, metrics, options, workers, progress, retries, extend, worker_timeout):
+    keys = [run_key(scene_key(scene), r, options) for r in runs]
+    defs = {n: metric_fingerprint(f) for n, f in metrics.items()}
+    try:
+        manifest = _manifest(out, scene, runs, keys, options, defs, extend)
+        rows, broken = {}, 0
+        for i, e in enumerate(manifest["runs"]):
+            row, problem = finished_row(out, e["key"])
+            if row is not None:
+                rows[e["key"]] = _refresh_metrics(out, row, metrics, defs)
+            elif problem:
+                broken += 1
+                print(f"mbdae sweep: run {i}: {problem}; it runs again", file=sys.stderr)
+    except OSError as e:
+        raise SweepOutputError(e.errno, f"{out}: cannot write the sweep's files: {e.strerror or e}; nothing "
+                               f"was run") from None
+    params = {e["key"]: e["params"] for e in manifest["runs"]}  # (a key listed twice runs once)
+    todo = [k for k in dict.fromkeys(e["key"] for e in manifest["runs"]) if k not in rows]
+    skipped = len(params) - len(todo)
+    bar = _Bar(len(params), skipped, progress)
+    try:
+        if todo:
+            _execute(scene, todo, params, out, client, metrics, options, workers, retries, worker_timeout, defs,
+                     rows, bar)
+    finally:
+        bar.close()
+    units = _units(scene, [e["params"] for e in manifest["runs"]], metrics)
+    try:
+        table = make_table(out, manifest, rows, list(metrics), units)
+    except OSError as e:
+        raise SweepOutputError(e.errno, f"{out}/runs.csv: cannot be written: {e.strerror or e}; every run is "
+                               f"finished and kept in {out}/runs (start the sweep again to write the table)") from None
+    table.attrs["skipped"] = skipped
+    table.attrs["rerun_broken"] = broken
+    return table
+
+
+def _execute(scene, todo, params, out, client, metrics, options, workers, retries, worker_timeout, defs, rows, bar):
+    """Submits the runs `todo` (keys), records each as it finishes; a write error stops the sweep
+    (SweepOutputError) with every run recorded before it whole."""
+    index = {k: i for i, k in enumerate(params)}
+    bk = backend(client, workers, retries)
+    token = uuid.uuid4().hex[:8]
+    futures = {bk.submit(run_one, scene, params[k], options, metrics, key=f"mbdae-run-{index[k]}-{token}"): k
+               for k in todo}
+    pending, clean = set(futures), False
+    try:
+        while pending:
+            done, pending = bk.wait(pending, 0.5)
+            for fut in done:
+                k = futures[fut]
                 try:
                     payload = fut.result()
                 except Exception as e:  # noqa: BLE001 -- a worker lost too often, a task error
                     payload = {"row": {"status": "lost", "message": f"{type(e).__name__}: {e}"}}
-                rows[i] = _record(out, i, keys[i], runs[i], payload)
-                bar.update(rows[i]["status"])
-                fut.release()
-    param_names = list(dict.fromkeys(k for run in runs for k in run))
-    table = _table(out, rows.values(), param_names, list(metrics))
-    table.attrs["skipped"] = len(runs) - len(todo)
-    return table
+                rows[k] = _record(out, index[k], k, params[k], payload, defs)
+                bar.update(rows[k]["status"])
+            if pending and bk.no_workers_for() > worker_timeout:
+                message = (f"no Dask worker for {worker_timeout:g} s ({bk.name}): every worker died or none "
+                           "connected; the run is repeated by the next sweep into this folder")
+                for fut in pending:
+                    rows[futures[fut]] = _record(out, index[futures[fut]], futures[fut], params[futures[fut]],
+                                                 {"row": {"status": "lost", "message": message}}, defs)
+                    fut.cancel()
+                print(f"mbdae sweep: {message}", file=sys.stderr)
+                pending = set()
+        clean = True
+    finally:
+        bk.close(cancel=not clean)
 
 
-def read_run(out, run):
-    """(DataFrame of run `run`'s samples, its parameters, its summary dict) from a sweep folder."""
-    import pandas as pd
-    path = Path(out) / "runs" / (_run_name(run) + ".h5")
-    with pd.HDFStore(path, mode="r") as store:
-        attrs = store.get_storer("results").attrs
-        return store["results"], json.loads(attrs.params), json.loads(attrs.summary)
+def _record(out, i, key, run, payload, defs):
+    try:
+        return record(out, i, key, run, payload, defs)
+    except OSError as e:
+        done = sum(1 for _ in (out / "runs").glob("*.json"))
+        raise SweepOutputError(e.errno, f"{out}: cannot write run {i}'s files: {e.strerror or e}; the sweep "
+                               f"stopped, {done} finished runs are kept whole in {out}/runs (start the same "
+                               f"sweep again to resume)") from None

@@ -198,3 +198,33 @@ def test_result_animation_draws_the_runs_frames(tmp_path):
     from PIL import Image
     with Image.open(gif) as im:
         assert im.size == (160, 120) and im.n_frames == len(frames)
+
+
+def test_run_with_animation_true_leaves_no_temporary_folder(tmp_path, monkeypatch):
+    # run(animation=True) without `out`: the frames go to a temporary folder that lives as long
+    # as the Result (collected, or at exit), and a run that raises leaves none.
+    import gc
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.setattr(tempfile, "tempdir", None)  # tempfile reads TMPDIR again
+    scene = mbdae.load(STEP).with_params({"analysis.dynamics.t_end": "0.05"})
+    r = scene.run(analysis="dynamics", output_step=0.01, animation=True)
+    folder = Path(r.animation_dir)
+    assert folder.parent == tmp_path and (folder / "animation.pvd").is_file()
+    r.animation(tmp_path / "a.gif", size=(80, 60))
+    del r
+    gc.collect()
+    assert not folder.exists() and not list(tmp_path.glob("mbdae_animation_*"))
+    with pytest.raises(ValueError):
+        scene.run(analysis="dynamics", animation=True, animation_rate=-1)
+    assert not list(tmp_path.glob("mbdae_animation_*"))
+    script = (f"import mbdae\nr = mbdae.load({str(STEP)!r}).with_params({{'analysis.dynamics.t_end': '0.05'}})"
+              ".run(analysis='dynamics', animation=True)\nprint(r.animation_dir)\n")
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "TMPDIR": str(tmp_path)})
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip().startswith(str(tmp_path)) and not Path(p.stdout.strip()).exists()

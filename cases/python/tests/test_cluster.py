@@ -1,7 +1,8 @@
 """A sweep through a separate Dask scheduler and two workers, started here as `dask scheduler`
-and `dask worker` processes on 127.0.0.1."""
+and `dask worker` processes on 127.0.0.1; and a sweep whose workers all die."""
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -13,12 +14,14 @@ import mbdae
 from conftest import STEP
 
 
-@pytest.fixture
-def scheduler(tmp_path):
+def start_cluster(tmp_path, nanny=True):
+    """(address, processes) of a scheduler and two one-thread workers on 127.0.0.1."""
     file = tmp_path / "scheduler.json"
-    procs = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                               "--scheduler-file", str(file)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    procs = []
     try:
+        procs.append(subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                       "--scheduler-file", str(file)], stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL))
         deadline = time.time() + 60
         while not file.exists() and time.time() < deadline:
             time.sleep(0.1)
@@ -26,18 +29,33 @@ def scheduler(tmp_path):
         assert address.startswith("tcp://127.0.0.1:")
         for _ in range(2):
             procs.append(subprocess.Popen(["dask", "worker", address, "--host", "127.0.0.1", "--nworkers", "1",
-                                           "--nthreads", "1", "--no-dashboard", "--local-directory", str(tmp_path)],
+                                           "--nthreads", "1", "--no-dashboard", "--local-directory", str(tmp_path),
+                                           *([] if nanny else ["--no-nanny"])],
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                           env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))))
+        return address, procs
+    except BaseException:
+        stop(procs)
+        raise
+
+
+def stop(procs):
+    for p in reversed(procs):
+        p.terminate()
+    for p in procs:
+        try:
+            p.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            p.kill()
+
+
+@pytest.fixture
+def scheduler(tmp_path):
+    address, procs = start_cluster(tmp_path)
+    try:
         yield address
     finally:
-        for p in reversed(procs):
-            p.terminate()
-        for p in procs:
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop(procs)
 
 
 def test_sweep_through_a_scheduler_address(scheduler, tmp_path):
@@ -54,3 +72,40 @@ def test_sweep_through_a_scheduler_address(scheduler, tmp_path):
         samples, _, _ = mbdae.read_run(tmp_path / "out", i)
         assert np.array_equal(samples["wheel_z"].to_numpy(), alone["wheel_z"])
         assert table["travel"][i] == np.max(np.abs(alone["wheel_z"] - alone["wheel_z"][0]))
+
+
+def test_a_sweep_whose_workers_all_die_ends_in_bounded_time(tmp_path):
+    """Both workers (no nanny to restart them) killed by PID while the sweep runs: the sweep
+    notices within worker_timeout (plus its polling), records the unfinished runs `lost` with
+    the reason, keeps the finished ones, and the next sweep runs the lost ones again."""
+    from distributed import Client
+    address, procs = start_cluster(tmp_path, nanny=False)
+    try:
+        with Client(address) as c:
+            c.wait_for_workers(2, timeout=60)
+            pids = list(c.run(os.getpid).values())
+
+        def slow(r):
+            time.sleep(0.5)
+            return float(r["wheel_z"][-1])
+        import threading
+        killer = threading.Timer(4.0, lambda: [os.kill(pid, signal.SIGKILL) for pid in pids])
+        killer.start()
+        t0 = time.monotonic()
+        params = [{"rtol": 10.0 ** -k} for k in np.linspace(6, 9, 40)]
+        table = mbdae.sweep(mbdae.load(STEP), params, out=tmp_path / "out", client=address, metrics={"end": slow},
+                            worker_timeout=5.0, progress=False)
+        elapsed = time.monotonic() - t0
+        killer.join()
+    finally:
+        stop(procs)
+    lost = table[table["status"] == "lost"]
+    assert len(lost) > 0 and (table["status"].isin(["ok", "lost"])).all(), table["status"].value_counts()
+    assert lost["message"].str.contains("no Dask worker for 5 s").all()
+    assert elapsed < 60, elapsed  # killed at 4 s, noticed 5 s later (plus polling and closing)
+    done = table[table["status"] == "ok"]
+    for _, row in done.iterrows():
+        samples, _, _ = mbdae.read_run(tmp_path / "out", row["run"])
+        assert len(samples) == row["rows"] > 0
+    again = mbdae.sweep(mbdae.load(STEP), params, out=tmp_path / "out", metrics={"end": slow}, progress=False)
+    assert again.attrs["skipped"] == len(done) and (again["status"] == "ok").all()

@@ -1,5 +1,5 @@
-"""Sweeps on a LocalCluster of 2 worker processes: equal to the runs one by one, failures
-recorded, resumed after a kill, a killed worker's task retried."""
+"""Sweeps on a LocalCluster of 2 worker processes (client="processes" or a Client): equal to
+the runs one by one, failures recorded, resumed after a kill, a killed worker's task retried."""
 import os
 import signal
 import subprocess
@@ -56,7 +56,9 @@ def test_sweep_equals_the_runs_one_by_one(client, tmp_path):
         alone = scene.with_params(overrides).run(**opts)
         samples, params, summary = mbdae.read_run(tmp_path, i)
         assert params == run and summary["status"] == "ok"
-        for c in alone.names:
+        assert samples.index.name == "t" and np.array_equal(samples.index.to_numpy(), alone["t"])
+        assert samples.attrs["units"] == dict(zip(alone.names, alone.units))
+        for c in alone.names[1:]:
             assert np.array_equal(samples[c].to_numpy(), alone[c]), (i, c)
         row = table.iloc[i]
         assert row["travel"] == np.max(np.abs(alone["wheel_z"] - alone["wheel_z"][0]))
@@ -72,7 +74,7 @@ def test_failed_and_invalid_runs_are_rows_and_the_rest_complete(client, tmp_path
     table = mbdae.sweep(mbdae.load(STEP), params, out=tmp_path / "a", client=client, metrics=METRICS)
     assert list(table["status"]) == ["ok", "invalid", "invalid", "ok"]
     assert "rtol" in table["message"][1] and "index7" in table["message"][2]
-    assert table["file"][1] == "" and table["file"][0] == "runs/run_00000.h5"  # no samples: no file
+    assert table["file"][1] == "" and table["file"][0] == f"runs/{table['key'][0]}.h5"  # no samples: no file
     # A solve failure keeps its partial samples and message.
     failing = mbdae.sweep(mbdae.load(PAST_TRAVEL), [{"output_step": 0.01}, {"output_step": 0.002}],
                           out=tmp_path / "b", client=client)
@@ -83,11 +85,10 @@ def test_failed_and_invalid_runs_are_rows_and_the_rest_complete(client, tmp_path
 
 
 @needs_overrides
-def test_bad_override_is_an_invalid_row(client, tmp_path):
-    mbdae.load(STEP).set("forces.tyre.stiffness", 2.0e5)  # raises until set_parameter lands
-    params = [{"forces.tyre.stiffness": 2.0e5}, {"forces.tyre.stiffness": -1.0}, {"forces.nothing.damping": 1.0}]
+def test_bad_value_is_an_invalid_row(client, tmp_path):
+    params = [{"forces.tyre.stiffness": 2.0e5}, {"forces.tyre.stiffness": -1.0}]
     table = mbdae.sweep(step_scene(), params, out=tmp_path, client=client)
-    assert list(table["status"]) == ["ok", "invalid", "invalid"]
+    assert list(table["status"]) == ["ok", "invalid"]
     assert "dynamics_step.yaml:" in table["message"][1] and "stiffness" in table["message"][1]
 
 
@@ -109,7 +110,7 @@ def test_sweep_killed_half_way_resumes_without_redoing_runs(tmp_path):
         time.sleep(0.02)
     os.killpg(p.pid, signal.SIGKILL)  # the sweep and its local worker process
     p.wait()
-    finished = {f: f.stat().st_mtime_ns for f in runs.glob("run_*.*") if f.suffix in (".json", ".h5")}
+    finished = {f: f.stat().st_mtime_ns for f in runs.glob("*.*") if f.suffix in (".json", ".h5")}
     n_done = len([f for f in finished if f.suffix == ".json"])
     assert 6 <= n_done < 30, n_done
     p = _shell_sweep(tmp_path)
