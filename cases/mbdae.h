@@ -116,6 +116,16 @@ class Sink {
   virtual void end(const Result& result) {}
 };
 
+// The checks run() makes before solving, without solving or writing anything: the system is
+// built (load expressions compiled, ModelError on failure) and its redundant constraints found
+// (ModelError with `redundant_constraints: fail`). Callers run it before they claim an output
+// folder, so that a rejected scene leaves the folder as it was.
+void check_runnable(const Scene& scene, const RunOptions& options);
+// The range checks of the command line's overrides (cases/cli_options.cpp) on RunOptions, for
+// callers that set them otherwise (the Python API): "rtol: out of range [1e-14, 0.5], got 1e-300",
+// one message per bad option, each starting with the option's name.
+std::vector<std::string> run_option_errors(const Scene& scene, const RunOptions& options);
+
 // Runs the scene's analyses in order (assembly, equilibrium, kinematics, dynamics). Scene and
 // model errors found while building the system throw ModelError (core/errors.h); a failing
 // solve does not throw: the Result says so and keeps what was computed.

@@ -36,6 +36,7 @@ struct UserData {
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
   std::string callback_error;  // an exception of the problem's residual or Jacobian
+  std::string callback_status;  // a SolveError's status (a load that is not finite), else empty
   int non_finite = -1;         // a component of y found not finite by weights_fn
   double non_finite_value = 0;
 };
@@ -71,11 +72,20 @@ int callback_failed(UserData* u, const char* where, const std::exception& e) {
   u->callback_error = std::string(where) + ": " + e.what();
   return -1;
 }
+// A SolveError of the problem (a load that is not finite, formulation/sensors.cpp) ends the run
+// with its own status and message.
+int callback_solve_error(UserData* u, const SolveError& e) {
+  u->callback_status = e.status;
+  u->callback_error = e.what();
+  return -1;
+}
 
 int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
   auto* u = static_cast<UserData*>(ud);
   try {
     return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r));
+  } catch (const SolveError& e) {
+    return callback_solve_error(u, e);
   } catch (const std::exception& e) {
     return callback_failed(u, "residual", e);
   }
@@ -93,6 +103,8 @@ int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector
   try {
     return u->problem->jacobian(t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                                 SUNSparseMatrix_Data(jac));
+  } catch (const SolveError& e) {
+    return callback_solve_error(u, e);
   } catch (const std::exception& e) {
     return callback_failed(u, "Jacobian", e);
   }
@@ -174,6 +186,9 @@ struct IdaRun {
   double t = 0, t_prev = 0;  // the current time and that of the last accepted step
   std::vector<double> y_prev, yp_prev;
   IdaStats stats;
+  long watch_steps = 0;  // steps since watch_t (the step budget, IdaOptions::max_total_steps)
+  double watch_t = 0;
+  int watch_strikes = 0;  // windows in a row whose rate projects more than the budget
 
   IdaRun() = default;
   IdaRun(const IdaRun&) = delete;
@@ -301,6 +316,7 @@ void ida_failure(IdaRun& r, int flag) {
         non_finite_error(r.problem->component_name(i) + " (y[" + std::to_string(i) + "])", r.ud.non_finite_value, tt);
     return fail(r, e.status, e.what(), tt);
   }
+  if (!r.ud.callback_status.empty()) return fail(r, r.ud.callback_status, r.ud.callback_error, tt);
   if (!r.ud.callback_error.empty())
     return fail(r, "internal_error", "the DAE's " + r.ud.callback_error + " (at t = " + std::to_string(tt) + ")", tt);
   std::ostringstream os;
@@ -473,6 +489,38 @@ bool advance(IdaRun& r) {
   return restart(r, is_root ? r.roots.data() : nullptr);
 }
 
+// The step budget (IdaOptions::max_total_steps), checked every kWatchWindow steps: the run
+// fails once it has spent the budget, or when kWatchStrikes windows in a row advanced t so
+// little that finishing at their rate would need more than the budget.
+constexpr long kWatchWindow = 10000;
+constexpr int kWatchStrikes = 10;
+
+bool over_budget(IdaRun& r) {
+  const IdaOptions& o = *r.o;
+  if (o.max_total_steps <= 0 || ++r.watch_steps < kWatchWindow) return false;
+  long steps = 0;
+  IDAGetNumSteps(r.mem, &steps);
+  steps += r.stats.steps;  // IDA's counter restarts at each reinit; stats holds the earlier ones
+  const double advanced = r.t - r.watch_t;
+  const double projected = steps + (advanced > 0 ? kWatchWindow * (o.t1 - r.t) / advanced : 1e300);
+  r.watch_strikes = projected > o.max_total_steps ? r.watch_strikes + 1 : 0;
+  r.watch_steps = 0;
+  r.watch_t = r.t;
+  if (steps < o.max_total_steps && r.watch_strikes < kWatchStrikes) return false;
+  double h = 0;
+  IDAGetCurrentStep(r.mem, &h);
+  std::ostringstream os;
+  os.precision(4);
+  os << "step limit: " << static_cast<double>(steps) << " steps by t = " << r.t << " (step size " << h << " s)";
+  if (steps < o.max_total_steps)
+    os << ", and at the rate of the last " << kWatchStrikes * kWatchWindow << " steps the run to t = " << o.t1
+       << " would need about " << projected << " steps";
+  os << ", more than max_steps = " << static_cast<double>(o.max_total_steps)
+     << " (a load or a motion growing without bound? raise max_steps in the step to go on; docs/errors.md)";
+  fail(r, "step_limit", os.str(), r.t);
+  return true;
+}
+
 }  // namespace
 
 IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>& y0, std::vector<double>& yp0,
@@ -488,10 +536,11 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   r.sample_index = 1;
   check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
   problem.set_segment(r.t, segment_end(r));
+  r.watch_t = o.t0;
   while (!r.stop_requested && r.stats.ok && r.t < o.t1) {
     if (o.stop && o.stop->load(std::memory_order_relaxed)) break;
     try {
-      if (!advance(r)) break;
+      if (!advance(r) || over_budget(r)) break;
     } catch (const SolveError& e) {  // a SUNDIALS call that failed (check)
       fail(r, e.status, e.what(), r.t);
       break;

@@ -58,7 +58,7 @@ void AugmentedSolver::assemble_acceleration_system(const std::vector<char>& mode
   assemble_values(q, true);
   check_overflow(values_.data(), static_cast<int>(values_.size()), t, "the mass matrix entries",
                  "a mass or an inertia");
-  generalized_forces(sys_, modes, q, v, t, rhs_.data());
+  generalized_forces(sys_, modes, q, v, t, rhs_.data(), turns);
   check_overflow(rhs_.data(), nq_, t, "the applied forces", "a mass, gravity or a force");
   constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
 }

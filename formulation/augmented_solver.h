@@ -53,6 +53,8 @@ class AugmentedSolver {
   // 1-norm condition estimate of [I Phi_q^T; Phi_q 0] at q: large near a singular configuration
   // (a lost or gained degree of freedom), about the ratio of extreme singular values of Phi_q.
   double constraint_condition(const double* q);
+  // The run's whole turns of rotation coordinates, for the loads (null: nearest the initial values).
+  const CoordinateTurns* turns = nullptr;
 
  private:
   void assemble(const double* q, bool with_mass, double regularization = 0.0);

@@ -172,12 +172,18 @@ void point_force_eval(const Force& f, const LocalState& x, double t, const LoadI
   }
 }
 
+// q - rest of a joint spring-damper: wrapped to (-pi, pi] if asked, else with the whole turns of
+// the load input (LoadInput::turns) added to the measured coordinate.
+double joint_stretch(const Force& f, double measured, const LoadInput* in) {
+  if (f.wrap && f.coordinate.rotation) return wrap_angle(measured - f.free_length);
+  return measured + (in ? in->turns : 0.0) - f.free_length;
+}
+
 void joint_spring_eval(const Force& f, const LocalState& x, const LocalState& v, Vec14& q,
-                       Mat14* dqx, Mat14* dqv) {
+                       Mat14* dqx, Mat14* dqv, const LoadInput* in) {
   const ScalarJet jet = coordinate_jet(f.coordinate, x);
   const Vec14 vl = local_vector(v);
-  const double stretch =
-      f.coordinate.rotation ? wrap_angle(jet.value - f.free_length) : jet.value - f.free_length;
+  const double stretch = joint_stretch(f, jet.value, in);
   const double rate = jet.grad.dot(vl);
   const double tau = f.stiffness * stretch + f.damping * rate;
   q.noalias() -= tau * jet.grad.transpose();
@@ -277,7 +283,7 @@ void force_eval(const Force& f, const LocalState& x, const LocalState& v, double
                 Mat14x3* dqin) {
   switch (f.type) {
     case ForceSpec::Type::kTorque: torque_eval(f, x, t, in, q, dqx, dqin); return;
-    case ForceSpec::Type::kJointSpringDamper: joint_spring_eval(f, x, v, q, dqx, dqv); return;
+    case ForceSpec::Type::kJointSpringDamper: joint_spring_eval(f, x, v, q, dqx, dqv, in); return;
     case ForceSpec::Type::kBushing: bushing_eval(f, x, v, q, dqx, dqv); return;
     case ForceSpec::Type::kSpringDamper:
     case ForceSpec::Type::kUser: {
@@ -372,7 +378,7 @@ double force_magnitude(const Force& f, const LocalState& x, const LocalState& v,
     case ForceSpec::Type::kJointSpringDamper: {
       // The generalized force on the coordinate, -tau (a torque for a rotation).
       Vec14 q = Vec14::Zero();
-      joint_spring_eval(f, x, v, q, nullptr, nullptr);
+      joint_spring_eval(f, x, v, q, nullptr, nullptr, in);
       const ScalarJet jet = coordinate_jet(f.coordinate, x);
       return q.dot(jet.grad.transpose()) / jet.grad.squaredNorm();
     }
@@ -393,7 +399,7 @@ double force_magnitude(const Force& f, const LocalState& x, const LocalState& v,
   }
 }
 
-double force_potential(const Force& f, const LocalState& x, double t, bool in_contact) {
+double force_potential(const Force& f, const LocalState& x, double t, bool in_contact, const LoadInput* in) {
   switch (f.type) {
     case ForceSpec::Type::kSpringDamper: {
       const double stretch = force_length(f, x, t) - f.free_length;
@@ -405,8 +411,7 @@ double force_potential(const Force& f, const LocalState& x, double t, bool in_co
       return 0.5 * f.stiffness * e * e;
     }
     case ForceSpec::Type::kJointSpringDamper: {
-      const double g = coordinate_jet(f.coordinate, x).value - f.free_length;
-      const double stretch = f.coordinate.rotation ? wrap_angle(g) : g;
+      const double stretch = joint_stretch(f, coordinate_jet(f.coordinate, x).value, in);
       return 0.5 * f.stiffness * stretch * stretch;
     }
     case ForceSpec::Type::kBushing: {

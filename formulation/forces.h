@@ -10,10 +10,11 @@
 //   point force:   f(t) given in world components, or in body axes (a follower force:
 //                  f = A(p) F, so dQ_r/dp = B(p, F), dQ_p/dp = K(s, f) + B(p, s)^T B(p, F));
 //   torque:        magnitude T(t) about a world or body-fixed axis (above);
-//   joint spring-damper: tau = k w(q - q0) + c q' on a joint coordinate q(x) with gradient G and
+//   joint spring-damper: tau = k (q - q0) + c q' on a joint coordinate q(x) with gradient G and
 //                  Hessian H (coordinate_jet): Q = -tau G^T, dQ/dx = -G^T (k G + c (H v)^T) - tau H,
-//                  dQ/dv = -c G^T G; w wraps a rotation difference to (-pi, pi] (so a torsional
-//                  spring is meant for twists below half a turn), translations are not wrapped;
+//                  dQ/dv = -c G^T G; a rotation q counts whole turns (LoadInput::turns, from
+//                  CoordinateTurns: a spring wound 10 rad gives -10 k), or with `wrap` q - q0 is
+//                  wrapped to (-pi, pi] (a spring acting within half a turn of its rest angle);
 //   bushing:       six coordinates y = (d, theta) of frame 2 relative to frame 1, d = C1^T A1^T
 //                  (P2 - P1) and theta = 2 sign(w0) w_vec, w = conj(p1 c1) (p2 c2) the relative
 //                  Euler parameters (c_k the frame's axes in its body): theta is the rotation
@@ -60,6 +61,7 @@ const UserForceLaw* find_force_law(const std::string& name);
 // the positions and velocities of the bodies in Force::reads (7 columns per body, in order).
 struct LoadInput {
   double value[3] = {0, 0, 0};
+  double turns = 0;  // joint spring-damper: 2 pi times the whole turns added to its measured coordinate
   double dq[3][7 * kMaxLoadReads], dv[3][7 * kMaxLoadReads];
 };
 using Mat14x3 = Eigen::Matrix<double, 14, 3>;
@@ -89,6 +91,7 @@ double force_magnitude(const Force& f, const LocalState& pos, const LocalState& 
                        bool in_contact, const LoadInput* input = nullptr);
 // Potential energy stored in a conservative element (spring-damper, joint spring-damper,
 // bushing, wheel contact in contact); 0 for the others.
-double force_potential(const Force& f, const LocalState& pos, double t, bool in_contact);
+double force_potential(const Force& f, const LocalState& pos, double t, bool in_contact,
+                       const LoadInput* input = nullptr);
 
 }  // namespace mbdae

@@ -57,7 +57,7 @@ void mass_times(const System& sys, const double* q, const double* acc, double* o
 }
 
 void generalized_forces(const System& sys, const std::vector<char>& modes, const double* q,
-                        const double* v, double t, double* out) {
+                        const double* v, double t, double* out, const CoordinateTurns* turns) {
   for (int b = 0; b < sys.num_bodies(); ++b) {
     const SystemBody& body = sys.bodies[b];
     double* o = out + 7 * b;
@@ -69,8 +69,7 @@ void generalized_forces(const System& sys, const std::vector<char>& modes, const
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
-    LoadInput in;
-    if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+    const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);
     force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr, &in);
     for (int l = 0; l < 14; ++l) {
       const int g = global_index(f.bi, f.bj, l);
@@ -179,16 +178,17 @@ void assemble_inertia_derivatives(const System& sys, const double* q, const doub
 
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
-                                int colv, SparseAssembler& a) {
+                                int colv, SparseAssembler& a, const CoordinateTurns* turns) {
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
     Vec14 ql = Vec14::Zero();
     Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
     if (!f.has_expression()) {
-      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv);
+      const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);  // a joint spring's turns
+      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in);
     } else {
       // Chain rule through the expression components to the bodies they read (forces.h).
-      const LoadInput in = load_input(sys, f, modes, q, v, t, true);
+      const LoadInput in = load_input(sys, f, modes, q, v, t, true, turns);
       Mat14x3 dqin = Mat14x3::Zero();
       force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in, &dqin);
       for (size_t r = 0; r < f.reads.size(); ++r)

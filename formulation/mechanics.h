@@ -27,8 +27,9 @@ std::vector<char> initial_modes(const System& sys, const double* q, double t);
 // out = M(q) a.
 void mass_times(const System& sys, const double* q, const double* a, double* out);
 // Q = gravity + applied forces - gyroscopic terms (the right side of M q'' + Phi_q^T l = Q).
+// `turns`: the run's whole turns of rotation coordinates (system.h; null: nearest to the initial values).
 void generalized_forces(const System& sys, const std::vector<char>& modes, const double* q,
-                        const double* v, double t, double* out);
+                        const double* v, double t, double* out, const CoordinateTurns* turns = nullptr);
 // Stacked constraint values Phi(q, t).
 void constraint_values(const System& sys, const std::vector<int>& offsets, const double* q,
                        double t, double* phi);
@@ -57,7 +58,7 @@ void assemble_inertia_derivatives(const System& sys, const double* q, const doub
 // -dQ/dq at (row0, colq) and -dQ/dv at (row0, colv) for the applied forces.
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
-                                int colv, SparseAssembler& a);
+                                int colv, SparseAssembler& a, const CoordinateTurns* turns = nullptr);
 // scale * Phi_q at (row0, col0), and/or its transpose at (row0t, col0t) (negative: skip).
 void assemble_constraint_jacobian(const System& sys, const std::vector<int>& offsets,
                                   const double* q, double scale, int row0, int col0, int row0t,

@@ -96,8 +96,10 @@ struct ForceSpec {
   double radius = 0;
   Vec3 axis = Vec3::UnitY();
   TimeFunction ground;
-  // Joint spring-damper: the joint coordinate.
+  // Joint spring-damper: the joint coordinate, and whether q - rest is wrapped to (-pi, pi]
+  // (`wrap`; by default a rotation counts whole turns: formulation/system.h, CoordinateTurns).
   std::string coordinate;
+  bool wrap = false;
   // Bushing: frame 1 at point1 with body1's axes, frame 2 at point2 with body2's axes; stiffness
   // and damping per frame-1 axis, translational (N/m, N s/m) and rotational (N m/rad, N m s/rad).
   Vec3 translational_stiffness = Vec3::Zero(), translational_damping = Vec3::Zero();
@@ -115,7 +117,9 @@ struct SensorSpec {
     kCoordinate, kCoordinateRate,         // joint coordinate and its rate
     kForceLength, kForceValue,            // length / tension of a force element
     kExpression,                          // derived from other sensors
-    kKineticEnergy, kPotentialEnergy      // whole system (formulation/sensors.cpp)
+    kKineticEnergy, kPotentialEnergy,     // whole system (formulation/sensors.cpp)
+    kAngularVelocity,                     // of a body, world or body-axes component
+    kAngularMomentum                      // of a body or the whole system about a world point
   };
   std::string name;
   Type type = Type::kPosition;
@@ -123,6 +127,9 @@ struct SensorSpec {
   Vec3 xyz = Vec3::Zero();          // the point as [x, y, z] in the body frame (if at_xyz)
   bool at_xyz = false;
   bool wrap = false;                // coordinate sensors: wrapped to (-pi, pi] instead of unwrapped
+  bool body_frame = false;          // angular velocity: component in the body's axes (else world)
+  Vec3 about = Vec3::Zero();        // angular momentum: the world point it is taken about
+  // body empty for angular momentum: of the whole system.
   Vec3 axis = Vec3::UnitX();
   int component = 0;
   std::string expression;

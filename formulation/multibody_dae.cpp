@@ -12,6 +12,8 @@ namespace mbdae {
 MultibodyDae::MultibodyDae(const System& sys)
     : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()), aug_(sys) {
   modes = initial_modes(sys, sys.q0.data(), 0.0);
+  turns = initial_turns(sys);
+  aug_.turns = &turns;
   for (const auto& b : sys.bodies) mass_scale_ = std::fmax(mass_scale_, b.mass);
   for (size_t k = 0; k < sys.forces.size(); ++k)
     if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
@@ -51,7 +53,7 @@ void MultibodyDae::kinematic_and_momentum_residual(double t, const double* y, co
   for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
   double* f2 = r + nq_;
   mass_times(sys_, q, yp + nq_, f2);
-  generalized_forces(sys_, modes, q, v, t, force_work);
+  generalized_forces(sys_, modes, q, v, t, force_work, &turns);
   for (int i = 0; i < nq_; ++i) f2[i] -= force_work[i];
   add_constraint_forces(sys_, offsets_, q, lambda, f2);
 }
@@ -69,7 +71,7 @@ void MultibodyDae::assemble_kinematic_and_momentum(double t, double cj, const do
   }
   assemble_mass(sys_, q, cj, rv, cv, a);
   assemble_inertia_derivatives(sys_, q, v, yp + nq_, rv, cq, cv, a);
-  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, a);
+  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, a, &turns);
   assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, a);
 }
 
@@ -174,6 +176,7 @@ void MultibodyDae::restart(double t, double* y, double* yp, const int* roots) {
   std::copy(yy.begin(), yy.end(), y);
   std::copy(yyp.begin(), yyp.end(), yp);
   set_switch_offsets(t, y);
+  update_turns(sys_, y, y + nq_, t, turns);
 }
 
 // The state at a root is a converged step onto the root time (core/ida_driver.cpp), which can lie
@@ -212,6 +215,7 @@ void MultibodyDae::after_step(double t_in, const double* y) {
     const double n = Eigen::Map<const Vec4>(y + 7 * b + 3).norm();
     max_norm_drift = std::fmax(max_norm_drift, std::fabs(n - 1.0));
   }
+  update_turns(sys_, y, y + nq_, t, turns);
 }
 
 void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, double* lambda) {

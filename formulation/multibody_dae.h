@@ -86,6 +86,7 @@ class MultibodyDae : public DaeProblem {
   bool output_needs_derivative() const override { return !output_velocities_from_state(); }
 
   std::vector<char> modes;            // per force: wheel in contact
+  CoordinateTurns turns;              // whole turns of rotation coordinates (system.h), after each accepted step
   double max_position_violation = 0;  // max |Phi| over accepted steps (integrator's own solution)
   double max_velocity_violation = 0;  // max |Phi_q v + Phi_t| over accepted steps
   // Solve accelerations for output samples (only needed by acceleration sensors).

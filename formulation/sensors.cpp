@@ -1,11 +1,24 @@
 #include "formulation/sensors.h"
 
-#include "formulation/forces.h"
-
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "core/finite_check.h"
+#include "formulation/forces.h"
 
 namespace mbdae {
+
+std::string load_field(const Force& f, int c) {
+  return f.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+}
+
+double joint_turns(const System& sys, const Force& f, const double* q, double t, const CoordinateTurns* turns) {
+  if (f.type != ForceSpec::Type::kJointSpringDamper || f.wrap || f.coordinate_index < 0) return 0.0;
+  const double raw = coordinate_value(sys, f.coordinate_index, q);
+  return continuous_coordinate(sys, f.coordinate_index, raw, t, turns) - raw;
+}
+
 namespace {
 
 // Whole-system energies (sensor types kinetic_energy and potential_energy).
@@ -43,20 +56,55 @@ double kinetic_energy(const System& sys, const double* q, const double* v) {
 // the ground height are constant: the force is vertical, K e, at the wheel centre, which is the
 // gradient of 1/2 K e^2 with respect to the centre height alone (a moving ground does work).
 double potential_energy(const System& sys, const std::vector<char>& modes, const double* q,
-                        double t) {
+                        double t, const CoordinateTurns* turns) {
   double u = 0;
   for (int b = 0; b < sys.num_bodies(); ++b)
     u -= sys.bodies[b].mass * sys.gravity.dot(Eigen::Map<const Vec3>(q + 7 * b));
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
-    u += force_potential(f, gather(q, f.bi, f.bj), t, modes[k]);
+    LoadInput in;
+    in.turns = joint_turns(sys, f, q, t, turns);
+    u += force_potential(f, gather(q, f.bi, f.bj), t, modes[k], &in);
   }
   return u;
 }
 
+// Angular velocity of body b: world omega = 2 E(p) p', body-axes omega' = 2 L(p) p', with
+// E(p) = [-e, [e]x + e0 I]. Both are bilinear, E(p) p' = -E(p') p (likewise L), which gives the
+// exact derivatives: d omega/dp = -2 E(p'), d omega/dp' = 2 E(p).
+Mat34 E_matrix(const Vec4& p) {
+  Mat34 m;
+  m.col(0) = -p.tail<3>();
+  m.rightCols<3>() = skew(p.tail<3>()) + p[0] * Mat3::Identity();
+  return m;
+}
+Mat34 omega_matrix(const Sensor& s, const Vec4& p) { return s.body_frame ? L_matrix(p) : E_matrix(p); }
+
+// Angular momentum (world components) about the world point c of body b:
+//   H_b = m (r - c) x r' + A(p) J omega',  omega' = 2 L(p) p'.
+// Bodies merged into ground carry none; a merged body is part of its host's rigid composite.
+Vec3 body_angular_momentum(const System& sys, int b, const double* q, const double* v, const Vec3& c) {
+  const SystemBody& body = sys.bodies[b];
+  const Vec3 r = Eigen::Map<const Vec3>(q + 7 * b), rd = Eigen::Map<const Vec3>(v + 7 * b);
+  const Vec4 p = Eigen::Map<const Vec4>(q + 7 * b + 3), pd = Eigen::Map<const Vec4>(v + 7 * b + 3);
+  const Vec3 w = 2.0 * L_matrix(p) * pd;
+  return body.mass * (r - c).cross(rd) + rotate(p, body.inertia * w);
+}
+
+double angular_momentum(const System& sys, const Sensor& s, const double* q, const double* v) {
+  Vec3 h = Vec3::Zero();
+  if (s.whole_system) {
+    for (int b = 0; b < sys.num_bodies(); ++b) h += body_angular_momentum(sys, b, q, v, s.point);
+  } else if (s.body >= 0) {
+    h = body_angular_momentum(sys, s.body, q, v, s.point);
+  }
+  return h[s.component];
+}
+
 // Value of sensor k; `earlier` holds the sensors before it (for expressions).
 double sensor_value(const System& sys, int k, const std::vector<char>& modes, const double* q,
-                    const double* v, const double* a, double t, const double* earlier);
+                    const double* v, const double* a, double t, const double* earlier,
+                    const CoordinateTurns* turns);
 
 // Derivatives of a sensor with respect to the local positions and velocities of its two bodies
 // (bi, bj as in gather): exact for points, axes and coordinates; for force lengths and values by
@@ -68,20 +116,32 @@ struct SensorGradient {
 
 SensorGradient force_sensor_gradient(const System& sys, const Sensor& s,
                                      const std::vector<char>& modes, const double* q,
-                                     const double* v, double t) {
-  const Force& f = sys.forces[s.target];
+                                     const double* v, double t, const CoordinateTurns* turns) {
   SensorGradient g;
-  g.bi = f.bi;
-  g.bj = f.bj;
-  const bool in_contact = modes[s.target];
+  const bool momentum = s.type == SensorSpec::Type::kAngularMomentum;  // of one body (loads)
+  const Force* f = momentum ? nullptr : &sys.forces[s.target];
+  g.bi = momentum ? s.body : f->bi;
+  g.bj = momentum ? -1 : f->bj;
+  // The turns of a joint spring are constant near the state: they shift its length and value only.
+  LoadInput in;
+  if (f) in.turns = joint_turns(sys, *f, q, t, turns);
   auto value = [&](const Vec14& x, const Vec14& xd) {
+    if (momentum) {
+      double qb[7], vb[7];
+      for (int l = 0; l < 7; ++l) qb[l] = x[l], vb[l] = xd[l];
+      const SystemBody& body = sys.bodies[s.body];
+      const Vec3 r(qb[0], qb[1], qb[2]), rd(vb[0], vb[1], vb[2]);
+      const Vec4 p(qb[3], qb[4], qb[5], qb[6]), pd(vb[3], vb[4], vb[5], vb[6]);
+      const Vec3 w = 2.0 * L_matrix(p) * pd;
+      return Vec3(body.mass * (r - s.point).cross(rd) + rotate(p, body.inertia * w))[s.component];
+    }
     return s.type == SensorSpec::Type::kForceLength
-               ? force_length(f, local_state(x), t)
-               : force_magnitude(f, local_state(x), local_state(xd), t, in_contact);
+               ? force_length(*f, local_state(x), t) + in.turns
+               : force_magnitude(*f, local_state(x), local_state(xd), t, modes[s.target], &in);
   };
-  const Vec14 x = local_vector(gather(q, f.bi, f.bj)), xd = local_vector(gather(v, f.bi, f.bj));
+  const Vec14 x = local_vector(gather(q, g.bi, g.bj)), xd = local_vector(gather(v, g.bi, g.bj));
   for (int l = 0; l < 14; ++l) {
-    if ((l < 7 && f.bi < 0) || (l >= 7 && f.bj < 0)) continue;
+    if ((l < 7 && g.bi < 0) || (l >= 7 && g.bj < 0)) continue;
     const double hx = 1e-6 * std::max(1.0, std::fabs(x[l])), hv = 1e-6 * std::max(1.0, std::fabs(xd[l]));
     Vec14 xp = x, xm = x, vp = xd, vm = xd;
     xp[l] += hx;
@@ -89,17 +149,17 @@ SensorGradient force_sensor_gradient(const System& sys, const Sensor& s,
     vp[l] += hv;
     vm[l] -= hv;
     g.dq(l) = (value(xp, xd) - value(xm, xd)) / (2 * hx);
-    if (s.type == SensorSpec::Type::kForceValue) g.dv(l) = (value(x, vp) - value(x, vm)) / (2 * hv);
+    if (s.type != SensorSpec::Type::kForceLength) g.dv(l) = (value(x, vp) - value(x, vm)) / (2 * hv);
   }
   return g;
 }
 
 SensorGradient sensor_gradient(const System& sys, const Sensor& s, const std::vector<char>& modes,
-                               const double* q, const double* v, double t) {
+                               const double* q, const double* v, double t, const CoordinateTurns* turns) {
   using T = SensorSpec::Type;
   SensorGradient g;
-  if (s.type == T::kForceLength || s.type == T::kForceValue)
-    return force_sensor_gradient(sys, s, modes, q, v, t);
+  if (s.type == T::kForceLength || s.type == T::kForceValue || (s.type == T::kAngularMomentum && s.body >= 0))
+    return force_sensor_gradient(sys, s, modes, q, v, t, turns);
   if (s.type == T::kCoordinate || s.type == T::kCoordinateRate) {
     const JointCoordinate& jc = sys.coordinates[s.target];
     if (jc.merged) return g;
@@ -130,13 +190,18 @@ SensorGradient sensor_gradient(const System& sys, const Sensor& s, const std::ve
       g.dq.segment<4>(3) = B_matrix(pd, s.point).row(c);
       break;
     case T::kAxis: g.dq.segment<4>(3) = B_matrix(p, s.axis).row(c); break;
+    case T::kAngularVelocity:  // axis . 2 E(p) p' (or L): bilinear in p and p'
+      g.dq.segment<4>(3) = -2.0 * s.axis.transpose() * omega_matrix(s, pd);
+      g.dv.segment<4>(3) = 2.0 * s.axis.transpose() * omega_matrix(s, p);
+      break;
     default: break;  // refused for loads by build_system
   }
   return g;
 }
 
 double sensor_value(const System& sys, int k, const std::vector<char>& modes, const double* q,
-                    const double* v, const double* a, double t, const double* earlier) {
+                    const double* v, const double* a, double t, const double* earlier,
+                    const CoordinateTurns* turns) {
   const Sensor& s = sys.sensors[k];
   const int b = s.body;
   const BodyPose x = body_pose(q, b), xd = body_pose(v, b, true);
@@ -146,21 +211,26 @@ double sensor_value(const System& sys, int k, const std::vector<char>& modes, co
     case SensorSpec::Type::kAcceleration:
       return point_acceleration(x, xd, a ? body_pose(a, b, true) : body_pose(nullptr, -1, true), s.point)[s.component];
     case SensorSpec::Type::kAxis: return (b < 0 ? s.axis : rotate(x.p, s.axis))[s.component];
-    case SensorSpec::Type::kCoordinate: return coordinate_value(sys, s.target, q);
+    case SensorSpec::Type::kCoordinate: {
+      const double raw = coordinate_value(sys, s.target, q);
+      return s.unwrap ? continuous_coordinate(sys, s.target, raw, t, turns) : raw;
+    }
     case SensorSpec::Type::kCoordinateRate: return coordinate_rate(sys, s.target, q, v);
     case SensorSpec::Type::kForceLength: {
       const Force& f = sys.forces[s.target];
-      return force_length(f, gather(q, f.bi, f.bj), t);
+      return force_length(f, gather(q, f.bi, f.bj), t) + joint_turns(sys, f, q, t, turns);
     }
     case SensorSpec::Type::kForceValue: {
       const Force& f = sys.forces[s.target];
-      LoadInput in;
-      if (f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
+      const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);
       return force_magnitude(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[s.target], &in);
     }
     case SensorSpec::Type::kExpression: return s.expression.evaluate(earlier);
     case SensorSpec::Type::kKineticEnergy: return kinetic_energy(sys, q, v);
-    case SensorSpec::Type::kPotentialEnergy: return potential_energy(sys, modes, q, t);
+    case SensorSpec::Type::kPotentialEnergy: return potential_energy(sys, modes, q, t, turns);
+    case SensorSpec::Type::kAngularVelocity:
+      return b < 0 ? 0.0 : s.axis.dot(2.0 * omega_matrix(s, x.p) * xd.p);
+    case SensorSpec::Type::kAngularMomentum: return angular_momentum(sys, s, q, v);
   }
   return 0.0;
 }
@@ -169,25 +239,32 @@ double sensor_value(const System& sys, int k, const std::vector<char>& modes, co
 
 void evaluate_sensors(const System& sys, const std::vector<char>& modes, const double* q,
                       const double* v, const double* a, double t, double* out,
-                      const double* previous) {
+                      const double* previous, const CoordinateTurns* turns) {
   for (int k = 0; k < static_cast<int>(sys.sensors.size()); ++k) {
     const Sensor& s = sys.sensors[k];
     const double reference = previous ? previous[k] : s.reference;  // read before out[k] is set
-    double value = sensor_value(sys, k, modes, q, v, a, t, out);
-    if (s.unwrap) value += 2 * M_PI * std::round((reference - value) / (2 * M_PI));
+    double value = sensor_value(sys, k, modes, q, v, a, t, out, turns);
+    if (s.unwrap && !turns) value += 2 * M_PI * std::round((reference - value) / (2 * M_PI));
     out[k] = value;
   }
 }
 
 LoadInput load_input(const System& sys, const Force& f, const std::vector<char>& modes,
-                     const double* q, const double* v, double t, bool with_gradient) {
+                     const double* q, const double* v, double t, bool with_gradient,
+                     const CoordinateTurns* turns) {
   LoadInput in;
+  in.turns = joint_turns(sys, f, q, t, turns);
+  if (!f.has_expression()) return in;
   const int np = static_cast<int>(f.parameters.size()), ni = static_cast<int>(f.inputs.size());
   double vars[kMaxLoadVariables];
   vars[0] = t;
   for (int k = 0; k < np; ++k) vars[1 + k] = f.parameters[k];
-  for (int k = 0; k < ni; ++k) vars[1 + np + k] = sensor_value(sys, f.inputs[k], modes, q, v, nullptr, t, nullptr);
+  for (int k = 0; k < ni; ++k) vars[1 + np + k] = sensor_value(sys, f.inputs[k], modes, q, v, nullptr, t, nullptr, turns);
   const int nr = static_cast<int>(f.reads.size());
+  for (int k = 0; k < ni; ++k)
+    if (!std::isfinite(vars[1 + np + k]))
+      throw non_finite_error("sensor '" + sys.sensors[f.inputs[k]].name + "' read by load '" + f.name + "'",
+                             vars[1 + np + k], t);
   for (int c = 0; c < 3; ++c) {
     std::fill(in.dq[c], in.dq[c] + 7 * nr, 0.0);
     std::fill(in.dv[c], in.dv[c] + 7 * nr, 0.0);
@@ -201,7 +278,7 @@ LoadInput load_input(const System& sys, const Force& f, const std::vector<char>&
     for (int k = 0; k < ni; ++k) {
       const double w = grad[1 + np + k];
       if (w == 0) continue;
-      const SensorGradient g = sensor_gradient(sys, sys.sensors[f.inputs[k]], modes, q, v, t);
+      const SensorGradient g = sensor_gradient(sys, sys.sensors[f.inputs[k]], modes, q, v, t, turns);
       for (int side = 0; side < 2; ++side) {
         const int body = side == 0 ? g.bi : g.bj;
         if (body < 0) continue;
@@ -213,6 +290,13 @@ LoadInput load_input(const System& sys, const Force& f, const std::vector<char>&
       }
     }
   }
+  // A load that is not finite where everything it reads is stops the run at once, by name: a
+  // Newton iteration cannot recover from it (an expression such as sqrt(0.01 - t) past its
+  // domain), and the integrator would only shrink its step until it gives up.
+  for (int c = 0; c < 3; ++c)
+    if (!f.expression[c].empty() && !std::isfinite(in.value[c]))
+      throw non_finite_error("load '" + f.name + "' (" + load_field(f, c) + " = " + f.expression[c].source + ")",
+                             in.value[c], t);
   return in;
 }
 

@@ -72,6 +72,43 @@ double coordinate_rate(const System& sys, int k, const double* q, const double* 
       gather_local(v, jc.function.body_parent, jc.function.body_child));
 }
 
+bool counts_turns(const System& sys, int k) {
+  const JointCoordinate& jc = sys.coordinates[k];
+  return !jc.merged && jc.function.rotation && jc.function.index != 1;
+}
+
+double continuous_coordinate(const System& sys, int k, double raw, double t, const CoordinateTurns* turns) {
+  if (!counts_turns(sys, k)) return raw;
+  double reference = sys.coordinates[k].spec.initial;
+  if (turns) {
+    reference = turns->value[k];
+    if (turns->timed) reference += turns->rate[k] * (t - turns->time);
+  }
+  if (!std::isfinite(reference)) return raw;
+  return raw + 2 * M_PI * std::round((reference - raw) / (2 * M_PI));
+}
+
+CoordinateTurns initial_turns(const System& sys) {
+  CoordinateTurns turns;
+  turns.value.resize(sys.coordinates.size());
+  turns.rate.assign(sys.coordinates.size(), 0.0);
+  for (size_t k = 0; k < sys.coordinates.size(); ++k) turns.value[k] = sys.coordinates[k].spec.initial;
+  return turns;
+}
+
+void update_turns(const System& sys, const double* q, const double* v, double t, CoordinateTurns& turns) {
+  for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
+    if (!counts_turns(sys, k)) continue;
+    const double value = continuous_coordinate(sys, k, coordinate_value(sys, k, q), t, &turns);
+    const double rate = coordinate_rate(sys, k, q, v);
+    if (!std::isfinite(value) || !std::isfinite(rate)) continue;  // the run stops on it elsewhere
+    turns.value[k] = value;
+    turns.rate[k] = rate;
+  }
+  turns.time = t;
+  turns.timed = true;
+}
+
 System build_system(const Model& model) {
   System sys;
   sys.name = model.name;

@@ -61,8 +61,12 @@ struct Force {
   // Point force and torque: components in body axes (frame_i: body1's axes in local coordinates).
   bool body_frame = false;
   Mat3 frame_i = Mat3::Identity(), frame_j = Mat3::Identity();
-  // Joint spring-damper: the coordinate it acts on (bi = its parent body, bj = its child body).
+  // Joint spring-damper: the coordinate it acts on (bi = its parent body, bj = its child body),
+  // its index in System::coordinates, and whether q - rest is wrapped to (-pi, pi] (`wrap`) or
+  // counted over whole turns (the default; CoordinateTurns).
   CoordinateFunction coordinate;
+  int coordinate_index = -1;
+  bool wrap = false;
   // Bushing: stiffness and damping per frame-1 axis (si, sj: the frames' origins).
   Vec3 kt = Vec3::Zero(), ct = Vec3::Zero(), kr = Vec3::Zero(), cr = Vec3::Zero();
   // Components given by expressions (empty: fx, fy, fz). Their variables are t (index 0), the
@@ -90,6 +94,10 @@ struct Sensor {
   // `wrap`; without a previous sample the value is taken nearest to `reference` (the initial value).
   bool unwrap = false;
   double reference = 0;
+  // Angular velocity: the value is axis . omega, omega in world axes, or in the body's local axes
+  // (body_frame; axis then maps them to the named body's own axes). Angular momentum: about the
+  // world point `point`, world component `component`, of body `body` or of every body (whole_system).
+  bool body_frame = false, whole_system = false;
 };
 
 struct System {
@@ -119,8 +127,30 @@ System build_system(const Model& model);
 // coordinates held, and for equilibrium).
 Constraint hold_constraint(const System& sys, int k, double value);
 
-// The current value of a joint coordinate.
+// The current value of a joint coordinate (a rotation measured in (-pi, pi]: see CoordinateTurns).
 double coordinate_value(const System& sys, int k, const double* q);
 double coordinate_rate(const System& sys, int k, const double* q, const double* v);
+
+// Whole turns of rotation coordinates. Euler parameters repeat after two turns, so a rotation
+// coordinate measured from them (coordinate_jet) is known only modulo 2 pi. The continuous
+// (multi-turn) value is the branch nearest to value[k] + rate[k] (t - time), the continuous
+// value and rate at the last accepted step (MultibodyDae::turns, updated after every accepted
+// step and restart): right while the coordinate moves less than pi away from that prediction
+// within one step. Without a CoordinateTurns the branch nearest to the coordinate's initial
+// value is taken (static analyses, the initial state).
+struct CoordinateTurns {
+  std::vector<double> value, rate;  // per System::coordinates entry
+  double time = 0;
+  bool timed = false;  // false: the prediction is value[k] (no rate yet)
+};
+// Whether coordinate k is a rotation whose turns are counted (atan2 angles: the first and last of a
+// chain's rotations; the middle one, an asin, stays within [-pi/2, pi/2]).
+bool counts_turns(const System& sys, int k);
+// The continuous value of coordinate k from its measured value `raw` at time t.
+double continuous_coordinate(const System& sys, int k, double raw, double t, const CoordinateTurns* turns);
+// Turns at the start (value: the coordinates' initial values, no rate).
+CoordinateTurns initial_turns(const System& sys);
+// The continuous values and rates at an accepted state (q, v) at t.
+void update_turns(const System& sys, const double* q, const double* v, double t, CoordinateTurns& turns);
 
 }  // namespace mbdae

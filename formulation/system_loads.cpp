@@ -36,6 +36,8 @@ void add_load_fields(const ForceSpec& fs, const System& sys, const NameIndex& co
     if (sys.coordinates[k].merged)
       fail(fs.where, "coordinate", "coordinate '" + fs.coordinate + "' belongs to a locked joint");
     f.coordinate = sys.coordinates[k].function;
+    f.coordinate_index = k;
+    f.wrap = fs.wrap;
     f.bi = f.coordinate.body_parent;
     f.bj = f.coordinate.body_child;
   }
@@ -79,9 +81,10 @@ int load_variable(const System& sys, const NameIndex& sensor_of, const std::vect
   using T = SensorSpec::Type;
   const Sensor& sensor = sys.sensors[s];
   if (sensor.type == T::kAcceleration || sensor.type == T::kExpression || sensor.type == T::kKineticEnergy ||
-      sensor.type == T::kPotentialEnergy)
+      sensor.type == T::kPotentialEnergy || (sensor.type == T::kAngularMomentum && sensor.whole_system))
     throw ExpressionError("sensor '" + n + "' cannot drive a load (loads read position, velocity, axis, "
-                          "coordinate, coordinate_rate, force_length and force_value sensors)", 0);
+                          "coordinate, coordinate_rate, force_length, force_value, angular_velocity and a "
+                          "body's angular_momentum sensors)", 0);
   if ((sensor.type == T::kForceLength || sensor.type == T::kForceValue) && is_expression_load[sensor.target])
     throw ExpressionError("sensor '" + n + "' measures a load given by an expression (loads may not depend on each other)", 0);
   auto it = std::find(f.inputs.begin(), f.inputs.end(), s);
@@ -157,6 +160,9 @@ void add_forces(const ModelIndex& index, System& sys, const NameIndex& coordinat
     f.axis = b1->local_vector(fs.axis.normalized());
     if (fs.type == ForceSpec::Type::kWheelContact && f.bi < 0)
       fail(fs.where, "body1", "wheel contact on a body merged into ground");
+    if ((fs.type == ForceSpec::Type::kTorque || fs.type == ForceSpec::Type::kPointForce) && f.bi < 0)
+      fail(fs.where, "body", std::string(fs.type == ForceSpec::Type::kTorque ? "torque" : "point force") + " '" +
+                                 fs.name + "' on ground (or a body fixed to it) does nothing");
     add_load_fields(fs, sys, coordinate_of, f);
     if (fs.type == ForceSpec::Type::kUser) {
       f.law = find_force_law(fs.law);
@@ -215,6 +221,22 @@ void add_sensors(const ModelIndex& index, System& sys, const NameIndex& coordina
       case SensorSpec::Type::kKineticEnergy:
       case SensorSpec::Type::kPotentialEnergy:
         break;  // whole-system quantities: nothing to resolve
+      case SensorSpec::Type::kAngularVelocity:
+      case SensorSpec::Type::kAngularMomentum: {
+        s.whole_system = ss.type == SensorSpec::Type::kAngularMomentum && ss.body.empty();
+        if (s.whole_system) {
+          s.point = ss.about;
+          break;
+        }
+        auto it = sys.frames.find(ss.body);
+        if (it == sys.frames.end()) fail(ss.where, "body", "no body named '" + ss.body + "'");
+        s.body = it->second.body;
+        s.point = ss.about;
+        // Body-axes components of the named body: its axis `component` in its host's local axes.
+        s.body_frame = ss.type == SensorSpec::Type::kAngularVelocity && ss.body_frame;
+        s.axis = s.body_frame ? it->second.local_vector(Vec3::Unit(ss.component)) : Vec3(Vec3::Unit(ss.component));
+        break;
+      }
       case SensorSpec::Type::kExpression: {
         try {  // sensor_of holds the sensors listed before this one
           s.expression = Expression::compile(ss.expression, [&](const std::string& n) { return find_name(sensor_of, n); });

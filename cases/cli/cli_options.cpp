@@ -126,15 +126,44 @@ std::string parse_command_line(const std::vector<std::string>& args, CommandLine
   return "";
 }
 
-std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl) {
-  const RunOptions& opt = cl.options;
-  std::vector<std::string> out = check_error_sensors(scene, cl.error.sensors, "--error-sensors");
+std::vector<std::string> run_option_errors(const Scene& scene, const RunOptions& opt) {
+  std::vector<std::string> out;
+  auto check = [&](const char* name, double v, bool given, const std::string& why) {
+    if (!given) return;
+    if (!std::isfinite(v)) out.push_back(std::string(name) + ": expected a finite number, got " + format_number(v));
+    else if (!why.empty()) out.push_back(std::string(name) + ": " + why);
+  };
+  // 0 means "not given" in RunOptions; a negative or NaN value is given and wrong.
+  check("rtol", opt.rtol, opt.rtol != 0, rtol_range_error(opt.rtol));
+  check("atol", opt.atol, opt.atol != 0, atol_range_error(opt.atol));
+  check("output_step", opt.output_step, opt.output_step != 0, output_step_range_error(opt.output_step, 0, 0));
+  if (!opt.formulation.empty()) {
+    const std::vector<std::string> known = formulations();
+    if (std::find(known.begin(), known.end(), opt.formulation) == known.end()) {
+      std::string list;
+      for (const auto& f : known) list += (list.empty() ? "" : ", ") + f;
+      out.push_back("formulation: expected one of " + list + ", got '" + opt.formulation + "'");
+    }
+  }
+  if (out.empty())
+    for (const std::string& m : check_overrides(scene, opt)) out.push_back("output_step" + m.substr(m.find(':')));
+  return out;
+}
+
+std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& opt) {
+  std::vector<std::string> out;
   if (!(opt.output_step > 0)) return out;
   for (const AnalysisStep& s : scene.steps) {
     if (!integrates(s)) continue;
     const std::string why = output_step_range_error(opt.output_step, s.t0, s.t_end);
     if (!why.empty()) out.push_back("--output-step: " + why);
   }
+  return out;
+}
+
+std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl) {
+  std::vector<std::string> out = check_error_sensors(scene, cl.error.sensors, "--error-sensors");
+  for (std::string& m : check_overrides(scene, cl.options)) out.push_back(std::move(m));
   return out;
 }
 

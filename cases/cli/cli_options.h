@@ -35,6 +35,8 @@ struct CommandLine {
 // Reads the arguments after the program name; returns "" or the usage error (exit code 1).
 std::string parse_command_line(const std::vector<std::string>& args, CommandLine& cl);
 // The command-line overrides checked against the scene's integration steps and sensors; empty if fine.
+std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& options);
+// The same with the command line's error sensors (--error-sensors) checked against the scene.
 std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl);
 void print_usage();
 

@@ -37,7 +37,28 @@ int print_parameters(const mbdae::Scene& scene) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command(int argc, char** argv);
+
+// Standard output (`check`'s verdict, `run`'s assembly report) that could not be written is an
+// I/O failure like any other file (exit code 4), not a success: `mbdae check s.yaml > /dev/full`.
+int checked_stdout(int code) {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return code;
+  const int err = errno;
+  std::fprintf(stderr, "mbdae: cannot write to standard output: %s%s\n", err ? std::strerror(err) : "write error",
+               code == 0 ? " (the output files, if any, are whole)" : "");
+  return code == 0 ? 4 : code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return checked_stdout(run_command(argc, argv)); }
+
+namespace {
+
+int run_command(int argc, char** argv) {
   mbdae::CommandLine cl;
   const std::string usage_error = mbdae::parse_command_line(std::vector<std::string>(argv + 1, argv + argc), cl);
   if (!usage_error.empty()) {
@@ -63,6 +84,7 @@ int main(int argc, char** argv) {
     const std::vector<std::string> bad_overrides = mbdae::check_overrides(scene, cl);
     for (const auto& m : bad_overrides) std::fprintf(stderr, "mbdae: %s\n", m.c_str());
     if (!bad_overrides.empty()) return 1;
+    mbdae::check_runnable(scene, opt);  // a scene refused here leaves the output folder as it was
     const bool animate = cl.animation || scene.animation.write;  // DIR/animation.pvd
     const mbdae::OutputRequest request{cl.out_dir, animate ? cl.out_dir : "", cl.animation_rate};
     mbdae::RunSinks out = mbdae::open_sinks(scene, request);
@@ -95,3 +117,5 @@ int main(int argc, char** argv) {
     return 3;
   }
 }
+
+}  // namespace

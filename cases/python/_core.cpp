@@ -3,6 +3,7 @@
 // their fields, and the Dask sweeps.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <memory>
 #include <string>
@@ -36,8 +37,10 @@ struct PyRunOptions : mbdae::RunOptions {
 
 // mbdae::run with the CLI's sinks (open_sinks, cases/output/sinks.h: the same folder lock) when an
 // output folder is given, and the animation sink; with an error estimate or target as asked
-// (fresh writers for every try of a target).
+// (fresh writers for every try of a target). As the CLI, the scene's system is checked before a
+// folder is touched (a refused scene leaves it as it was).
 mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
+  if (!options.out_dir.empty() || !options.animation_dir.empty()) mbdae::check_runnable(scene, options);
   const mbdae::OutputRequest request{options.out_dir, options.animation_dir, options.animation_rate};
   mbdae::RunSinks out = mbdae::open_sinks(scene, request);
   int tries = 0;
@@ -47,6 +50,18 @@ mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& opti
   };
   return mbdae::run_controlled(scene, options, mbdae::error_control(scene, options.error), make_sinks,
                                options.out_dir.empty() ? "" : options.out_dir + "/summary.json");
+}
+
+// The checks `mbdae run` makes on its options (ValueError naming the option), before anything runs.
+void check_options(const mbdae::Scene& scene, const PyRunOptions& options) {
+  std::vector<std::string> bad = mbdae::run_option_errors(scene, options);
+  if (!(options.animation_rate >= 0) || !std::isfinite(options.animation_rate))
+    bad.push_back("animation_rate: must be a positive number of frames per second, got " +
+                  std::to_string(options.animation_rate));
+  if (bad.empty()) return;
+  std::string text;
+  for (const auto& m : bad) text += (text.empty() ? "" : "\n") + m;
+  throw py::value_error(text);
 }
 
 // A column of a Result as a read-only numpy array over the Result's own memory (no copy): the
@@ -73,6 +88,7 @@ const char* step_type_name(mbdae::AnalysisStep::Type t) { return mbdae::analysis
 // to a helper thread while this one checks for Ctrl-C every 50 ms: a signal stops the run at its
 // next step (RunOptions::stop) and is raised (KeyboardInterrupt) once the run has ended.
 std::shared_ptr<mbdae::Result> run_released(const mbdae::Scene& scene, PyRunOptions options) {
+  check_options(scene, options);
   const mbdae::Scene copy = scene;
   const bool main_thread = PyThread_get_thread_ident() == main_thread_id();
   if (!main_thread) {
@@ -160,6 +176,9 @@ void bind_run(py::module_& m) {
       .def_property_readonly("summary_json", [](const mbdae::Result& r) { return r.summary.dump(); })
       .def("column", [](py::object self, size_t k) { return column_view(self, self.cast<const mbdae::Result&>(), k); });
   m.def("run", &run_released, py::arg("scene"), py::arg("options"));
+  m.def("option_errors", [](const mbdae::Scene& scene, const PyRunOptions& options) {
+    return mbdae::run_option_errors(scene, options);
+  }, py::arg("scene"), py::arg("options"));
 }
 
 }  // namespace
@@ -178,6 +197,8 @@ PYBIND11_MODULE(_core, m) {
       raise(e.messages);
     } catch (const mbdae::ModelError& e) {
       raise({e.what()});
+    } catch (const mbdae::OutputError& e) {  // a folder in use, a file that cannot be written
+      PyErr_SetString(PyExc_OSError, e.what());
     }
   });
   bind_scene(m);

@@ -41,6 +41,7 @@ IdaOptions integration_options(const RunOptions& opt, const AnalysisStep& step, 
   io.atol = tol.absolute.position;
   io.output_step = opt.output_step > 0 ? opt.output_step : step.output_step;
   io.max_step = step.max_step;
+  io.max_total_steps = static_cast<long>(step.max_steps);
   io.stop = opt.stop;
   io.nonlinear_convergence = step.newton_convergence;
   io.reduced_newton = step.newton_solve == "reduced";
@@ -81,6 +82,10 @@ bool start(RunContext& c, const AnalysisStep& step, MultibodyDae& dae, std::vect
            std::vector<double>& yp, json& js) {
   const System& sys = *c.system;
   dae.modes = initial_modes(sys, c.q.data(), step.t0);
+  if (c.turns) {  // the turns counted by the previous integration step
+    dae.turns = *c.turns;
+    dae.turns.timed = false;
+  }
   dae.track_condition = step.type == AnalysisStep::Type::kKinematics;  // closeness to a singular configuration
   dae.output_accelerations = false;  // output samples solve for accelerations only if a sensor reports one
   for (const auto& s : sys.sensors)
@@ -165,7 +170,6 @@ struct Sampler {
   std::vector<double> quiet_ref, quiet_max;
   std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now(), last_print = wall0;
   bool printed = false;
-  bool first_sample = true;
   std::string sink_error;  // a sink's failure (stops the run)
 
   Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, SetAsideWatch& w, double output_step)
@@ -186,10 +190,9 @@ struct Sampler {
         std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
     if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
     if (!set_aside(sys, qo.data(), dae.input_time(t))) return false;  // not the mechanism's motion: not written
-    // Coordinate sensors unwrap against the previous sample (formulation/sensors.h).
-    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(),
-                     first_sample ? nullptr : sensors.data());
-    first_sample = false;
+    // Coordinate sensors count whole turns as the loads do (formulation/system.h, CoordinateTurns).
+    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(), nullptr,
+                     &dae.turns);
     row[0] = t;
     for (size_t k = 0; k < c.column_sensors.size(); ++k) row[k + 1] = sensors[c.column_sensors[k]];
     if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
@@ -301,6 +304,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
   std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
+  c.turns = dae->turns;
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
   js["event_times"] = st.event_times;
   js["breakpoint_times"] = st.breakpoint_times;

@@ -50,6 +50,8 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     }
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
+    case T::kAngularVelocity: return "rad/s";
+    case T::kAngularMomentum: return "N m s";
     case T::kExpression: return "";
   }
   return "";
@@ -218,6 +220,13 @@ bool run_step(RunContext& c, const AnalysisStep& step) {
 }
 
 }  // namespace
+
+void check_runnable(const Scene& scene, const RunOptions& options) {
+  json summary;
+  RunOptions quiet = options;  // run() reports what it removes
+  quiet.verbose = false;
+  build_checked_system(scene, quiet, summary);
+}
 
 Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink*>& sinks) {
   Result result;

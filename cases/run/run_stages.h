@@ -10,6 +10,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct RunContext {
   std::vector<int> column_sensors;       // sensor index of each Result column after "t"
   nlohmann::ordered_json steps = nlohmann::ordered_json::array();
   nlohmann::ordered_json warnings = nlohmann::ordered_json::array();
+  // Whole turns of the rotation coordinates at the end of the last integration step, so that the
+  // next one starts with the same count (formulation/system.h, CoordinateTurns).
+  std::optional<CoordinateTurns> turns = std::nullopt;
 };
 
 std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& options,

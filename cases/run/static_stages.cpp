@@ -46,7 +46,8 @@ void print_configuration(const System& sys, const double* q, double t) {
   for (size_t k = 0; k < sys.sensors.size(); ++k) {
     const auto type = sys.sensors[k].type;
     if (type == SensorSpec::Type::kAcceleration || type == SensorSpec::Type::kVelocity ||
-        type == SensorSpec::Type::kCoordinateRate)
+        type == SensorSpec::Type::kCoordinateRate || type == SensorSpec::Type::kAngularVelocity ||
+        type == SensorSpec::Type::kAngularMomentum)
       continue;
     std::printf("    %-12s = %.12f\n", sys.sensors[k].name.c_str(), out[k]);
   }

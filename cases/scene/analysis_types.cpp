@@ -10,7 +10,7 @@ namespace {
 
 // The fields of a step that integrates in time, kinematics and dynamics alike.
 std::vector<std::string> integration_fields() {
-  return {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "constraint_scale", "formulation",
+  return {"type", "t0", "t_end", "output_step", "rtol", "atol", "max_step", "max_steps", "constraint_scale", "formulation",
           "baumgarte_alpha", "baumgarte_beta", "penalty", "newton_convergence", "newton_solve", "output_projection",
           "length_scale", "time_scale", "atol_rotation", "atol_velocity", "error_estimate", "error_target", "error_sensors", "quiet_until",
           "quiet_sensors", "initial_velocities"};

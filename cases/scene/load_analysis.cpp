@@ -80,6 +80,11 @@ void Loader::step_span_and_tolerances(const YAML::Node& n, bool integrates, Anal
   if (rtol && !rtol_range_error(s.rtol).empty()) error(n["rtol"], "rtol", rtol_range_error(s.rtol));
   if (atol && !atol_range_error(s.atol).empty()) error(n["atol"], "atol", atol_range_error(s.atol));
   if (max_step && s.max_step < 0) error(n["max_step"], "max_step", "must not be negative (0: no limit), got " + format_number(s.max_step));
+  if (const auto x = opt_number(n, "max_steps")) {
+    if (!(*x >= 1 && *x <= 1e15 && *x == std::floor(*x)))
+      error(n["max_steps"], "max_steps", "expected a whole number of steps in [1, 1e15], got " + format_number(*x));
+    else s.max_steps = *x;
+  }
 }
 
 

@@ -132,6 +132,7 @@ void Loader::joint_spring_damper(const YAML::Node& n, ForceSpec& f) {
   if (has(n, "rest") && has(n, "rest_deg")) error(n["rest_deg"], "rest_deg", "give rest or rest_deg, not both");
   if (has(n, "rest")) f.free_length = number(n, "rest", 0.0);
   else if (has(n, "rest_deg")) f.free_length = number(n, "rest_deg", 0.0) * kDeg;
+  flag(n, "wrap", f.wrap);
 }
 
 void Loader::bushing(const YAML::Node& n, ForceSpec& f) {
@@ -170,7 +171,7 @@ const std::vector<Loader::ForceType>& Loader::force_types() {
        &Loader::point_force},
       {"torque", T::kTorque, {"name", "type", "body", "axis", "frame", "torque", "parameters"}, &Loader::torque},
       {"joint_spring_damper", T::kJointSpringDamper,
-       {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg"}, &Loader::joint_spring_damper},
+       {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg", "wrap"}, &Loader::joint_spring_damper},
       {"bushing", T::kBushing,
        {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "rotational_stiffness",
         "rotational_damping"},
@@ -188,7 +189,7 @@ void Loader::force(const YAML::Node& n, Model& m) {
   static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
                                  "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
                                  "ground", "law", "parameters", "frame", "torque", "coordinate", "rest",
-                                 "rest_deg", "rotational_stiffness", "rotational_damping"};
+                                 "rest_deg", "rotational_stiffness", "rotational_damping", "wrap"};
   if (!check_keys(n, "force", general)) return;
   ForceSpec f;
   f.where = where(n);

@@ -25,7 +25,8 @@ namespace mbdae::scene_load {
 
 
 void Loader::sensor(const YAML::Node& n, Model& m) {
-  static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force", "expression", "wrap"};
+  static const Fields general = {"name", "type", "body", "point", "component", "axis", "coordinate", "force",
+                                 "expression", "wrap", "frame", "about"};
   if (!check_keys(n, "sensor", general)) return;
   SensorSpec s;
   s.where = where(n);
@@ -39,7 +40,8 @@ void Loader::sensor(const YAML::Node& n, Model& m) {
       {"position", T::kPosition}, {"velocity", T::kVelocity}, {"acceleration", T::kAcceleration},
       {"axis", T::kAxis}, {"coordinate", T::kCoordinate}, {"coordinate_rate", T::kCoordinateRate},
       {"force_length", T::kForceLength}, {"force_value", T::kForceValue}, {"expression", T::kExpression},
-      {"kinetic_energy", T::kKineticEnergy}, {"potential_energy", T::kPotentialEnergy}};
+      {"kinetic_energy", T::kKineticEnergy}, {"potential_energy", T::kPotentialEnergy},
+      {"angular_velocity", T::kAngularVelocity}, {"angular_momentum", T::kAngularMomentum}};
   auto it = types.find(type);
   if (it == types.end()) {
     if (!type.empty()) {
@@ -83,6 +85,22 @@ void Loader::sensor(const YAML::Node& n, Model& m) {
     case T::kExpression:
       applies(n, what, general, {"name", "type", "expression"});
       s.expression = name(n, "expression");
+      break;
+    case T::kAngularVelocity: {
+      applies(n, what, general, {"name", "type", "body", "component", "frame"});
+      s.body = name(n, "body");
+      s.component = axis_component(n, "component");
+      const std::string fr = text(n, "frame", "world");
+      s.body_frame = fr == "body";
+      if (fr != "world" && fr != "body" && n["frame"].IsScalar())
+        error(n["frame"], "frame", "expected world or body, got " + quote(fr));
+      break;
+    }
+    case T::kAngularMomentum:
+      applies(n, what, general, {"name", "type", "body", "component", "about"});
+      if (has(n, "body")) s.body = name(n, "body");  // absent: the whole system
+      s.about = vec3(n, "about", Vec3::Zero());
+      s.component = axis_component(n, "component");
       break;
     default:  // whole-system sensors
       applies(n, what, general, {"name", "type"});

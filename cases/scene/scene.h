@@ -21,6 +21,9 @@ struct AnalysisStep {
   // atol_velocity [m/s] are given; the scales are derived from the model unless given
   // (formulation/tolerance_scales.h).
   double rtol = 1e-6, atol = 0, max_step = 0;
+  // The step budget (core/ida_driver.h, IdaOptions::max_total_steps): the run fails with status
+  // step_limit after this many steps, or as soon as its rate projects more over [t0, t_end].
+  double max_steps = 1e8;
   double length_scale = 0, time_scale = 0, atol_rotation = 0, atol_velocity = 0;
   bool error_estimate = false;  // estimate the run's global error (cases/run/error_estimate.h)
   // > 0: pick rtol and atol so that the estimated global error of error_sensors (default every

@@ -1,9 +1,12 @@
 // Scene and model files: reading within the size limit, one YAML document per file, syntax errors with their line.
 #include "cases/scene/loader.h"
 
+#include <yaml-cpp/depthguard.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -122,7 +125,59 @@ int second_document_line(const std::string& text) {
   return 0;
 }
 
+// A control character in the raw text (YAML allows tab and line breaks only; a NUL ends yaml-cpp's
+// input early, so that its own error names a wrong line): false after naming its line and column.
+bool text_is_clean(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
+  int line = 1;
+  size_t line_start = 0;
+  for (size_t k = 0; k < text.size(); ++k) {
+    const unsigned char c = static_cast<unsigned char>(text[k]);
+    if (c == '\n') {
+      ++line;
+      line_start = k + 1;
+    } else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f) {
+      char code[16];
+      std::snprintf(code, sizeof code, "0x%02x", c);
+      issues.push_back({path, line, "",
+                        std::string("a control character (") + code + (c == 0 ? ", NUL" : "") + ") at column " +
+                            std::to_string(k - line_start + 1) +
+                            ": a scene or model file is YAML text (no control characters but tab and line breaks)"});
+      return false;
+    }
+  }
+  return true;
+}
+
+// The line where the nesting of flow collections ('[', '{' outside quotes and comments) is deepest,
+// or `mark_line` (yaml-cpp's, 1-based) when there is none or it lies inside the text (block nesting).
+int deepest_line(const std::string& text, int mark_line) {
+  int line = 1, depth = 0, deepest = 0, deepest_at = 0;
+  char quote = 0;
+  bool comment = false;
+  for (const char c : text) {
+    if (c == '\n') {
+      ++line;
+      comment = false;
+      continue;
+    }
+    if (comment) continue;
+    if (quote) {
+      if (c == quote) quote = 0;
+      continue;
+    }
+    if (c == '"' || c == '\'') quote = c;
+    else if (c == '#') comment = true;
+    else if (c == '[' || c == '{') {
+      if (++depth > deepest) deepest = depth, deepest_at = line;
+    } else if ((c == ']' || c == '}') && depth > 0) --depth;
+  }
+  const int lines = line - (!text.empty() && text.back() == '\n' ? 1 : 0);
+  if (deepest_at > 0 && (mark_line <= 0 || mark_line > lines || deepest > 100)) return deepest_at;
+  return mark_line > 0 ? std::min(mark_line, lines) : 0;
+}
+
 std::optional<YAML::Node> parse(const std::string& text, const std::string& path, std::vector<SceneIssue>& issues) {
+  if (!text_is_clean(text, path, issues)) return std::nullopt;
   try {
     // One document per file: a second one (after '---') would be silently ignored by YAML::Load.
     if (const int second = second_document_line(text)) {
@@ -140,6 +195,11 @@ std::optional<YAML::Node> parse(const std::string& text, const std::string& path
       return std::nullopt;
     }
     return root;
+  } catch (const YAML::DeepRecursion& e) {  // its own text is "bad file", its mark often the end
+    issues.push_back({path, deepest_line(text, e.mark.line + 1), "",
+                      "lists and mappings nested too deeply (yaml-cpp stops at " + std::to_string(e.depth()) +
+                          " levels of recursion); a scene or model file needs a few"});
+    return std::nullopt;
   } catch (const YAML::Exception& e) {
     issues.push_back({path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "YAML syntax error: " + e.msg});
     return std::nullopt;

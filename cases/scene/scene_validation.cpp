@@ -365,6 +365,12 @@ struct Validator {
         case ForceSpec::Type::kWheelContact:
         case ForceSpec::Type::kTorque:
           check_point(f.where, who, "body", f.body1, "point", f.point1);
+          if (f.type != ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&
+              same_rigid_body(f.body1, kGround)) {
+            const std::string what = f.type == ForceSpec::Type::kTorque ? "a torque" : "a point force";
+            report(f.where, "body", who + (f.body1 == kGround ? what + " on ground does nothing (ground does not move); apply it to a moving body"
+                                                              : what + " on '" + f.body1 + "', which is fixed to ground (its joints to ground are locked or welds), does nothing"));
+          }
           break;
         case ForceSpec::Type::kJointSpringDamper:
           if (!f.coordinate.empty() && !joint_of_coordinate.count(f.coordinate))
@@ -419,6 +425,8 @@ struct Validator {
           check_point(s.where, who, "body", s.body, "point", s.point);
           break;
         case T::kAxis:
+        case T::kAngularVelocity:
+        case T::kAngularMomentum:
           if (!s.body.empty() && !known_body(s.body)) report(s.where, "body", who + no_body(s.body));
           break;
         case T::kCoordinate:
@@ -442,6 +450,78 @@ struct Validator {
     }
   }
 
+  // The expression components of point forces and torques, before anything is solved or written:
+  // names (t, the force's parameters, sensors that a load may read), parameters that would hide a
+  // sensor of the same name, and the nesting depth. build_system() checks them again.
+  void check_load_expressions() {
+    std::set<std::string> expression_loads;
+    for (const auto& f : m.forces)
+      if (!f.expression[0].empty() || !f.expression[1].empty() || !f.expression[2].empty()) expression_loads.insert(f.name);
+    for (const auto& f : m.forces) {
+      if (!expression_loads.count(f.name)) continue;
+      const std::string who = "force '" + f.name + "': ";
+      for (const auto& [p, value] : f.parameters)
+        if (sensor_index.count(p))
+          report(f.where, "parameters." + p, who + "parameter '" + p + "' has the name of a sensor (in the expressions "
+                                                   "it would hide the sensor); rename one of them");
+      for (int c = 0; c < 3; ++c) {
+        if (f.expression[c].empty()) continue;
+        const std::string field = f.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+        check_load_expression(f, who, field, f.expression[c], expression_loads);
+      }
+    }
+  }
+
+  void check_load_expression(const ForceSpec& f, const std::string& who, const std::string& field,
+                             const std::string& text, const std::set<std::string>& expression_loads) {
+    std::vector<std::string> problems;
+    auto note = [&](const std::string& m) {
+      if (std::find(problems.begin(), problems.end(), m) == problems.end()) problems.push_back(m);
+    };
+    try {
+      const Expression e = Expression::compile(text, [&](const std::string& n) {
+        if (n == "t" || f.parameters.count(n)) return 0;
+        const auto it = sensor_index.find(n);
+        if (it == sensor_index.end()) {
+          note("unknown name '" + n + "' (names are t, the force's parameters and sensors)" +
+               suggestion(n, keys(sensor_index)));
+          return 0;
+        }
+        const SensorSpec& s = m.sensors[it->second];
+        using T = SensorSpec::Type;
+        if (s.type == T::kAcceleration || s.type == T::kExpression || s.type == T::kKineticEnergy ||
+            s.type == T::kPotentialEnergy || (s.type == T::kAngularMomentum && s.body.empty()))
+          note("sensor '" + n + "' cannot drive a load (loads read position, velocity, axis, coordinate, "
+               "coordinate_rate, force_length, force_value, angular_velocity and a body's angular_momentum sensors)");
+        else if ((s.type == T::kForceLength || s.type == T::kForceValue) && expression_loads.count(s.target))
+          note("sensor '" + n + "' measures a load given by an expression (loads may not depend on each other)");
+        return 0;
+      });
+      if (stack_depth(e) > kExpressionStack)
+        note("the expression is nested too deeply (it needs " + std::to_string(stack_depth(e)) +
+             " evaluation stack entries, at most " + std::to_string(kExpressionStack) + ")");
+    } catch (const ExpressionError& e) {
+      note(e.what());
+    }
+    for (const auto& p : problems) report(f.where, field, who + p);
+  }
+
+  // Evaluation stack entries the compiled code needs.
+  static int stack_depth(const Expression& e) {
+    int depth = 0, deepest = 0;
+    for (const auto& in : e.code) {
+      switch (in.op) {
+        case Expression::Op::kConst:
+        case Expression::Op::kVar: ++depth; break;
+        case Expression::Op::kNeg:
+        case Expression::Op::kCall1: break;
+        default: --depth; break;
+      }
+      deepest = std::max(deepest, depth);
+    }
+    return deepest;
+  }
+
   void check_expression(const SensorSpec& s, const std::string& who, const std::map<std::string, int>& before) {
     if (s.expression.empty()) return;
     std::vector<std::string> unknown;
@@ -452,17 +532,7 @@ struct Validator {
         if (std::find(unknown.begin(), unknown.end(), n) == unknown.end()) unknown.push_back(n);
         return 0;  // carry on to find every unknown name
       });
-      int depth = 0, deepest = 0;
-      for (const auto& in : e.code) {
-        switch (in.op) {
-          case Expression::Op::kConst:
-          case Expression::Op::kVar: ++depth; break;
-          case Expression::Op::kNeg:
-          case Expression::Op::kCall1: break;
-          default: --depth; break;
-        }
-        deepest = std::max(deepest, depth);
-      }
+      const int deepest = stack_depth(e);
       if (deepest > kExpressionStack)
         report(s.where, "expression", who + "the expression is nested too deeply (it needs " + std::to_string(deepest) +
                                           " evaluation stack entries, at most " + std::to_string(kExpressionStack) + ")");
@@ -591,6 +661,7 @@ void validate_scene(const Scene& scene, const FieldLines& lines, std::vector<Sce
   v.check_cuts();
   v.check_forces();
   v.check_sensors();
+  v.check_load_expressions();
   v.check_output();
   v.check_steps();
 }

@@ -156,23 +156,29 @@ TEST(Loads, FollowerForceAgainstATorsionalSpringSettlesAtFLOverK) {
 // Torsional pendulum: J = 0.5, k = 8 (omega = 4, period pi / 2), theta0 = 0.3 from rest:
 // theta = theta0 cos(omega t); with damping c = 0.4 (zeta = c / (2 sqrt(k J)) = 0.1):
 // theta = theta0 exp(-zeta omega t) (cos(wd t) + zeta / sqrt(1 - zeta^2) sin(wd t)).
+// Wound 10 rad (1.6 turns; issue 25) the same closed form holds: the spring counts whole turns
+// (it wrapped q - rest to (-pi, pi] before, and snapped through at pi), and so does the sensor.
 TEST(Loads, TorsionalPendulum) {
+  for (double theta0 : {0.3, 10.0})
   for (double c : {0.0, 0.4}) {
     std::string text = wheel("  - {name: spring, type: joint_spring_damper, coordinate: theta, stiffness: 8, damping: " +
                                  std::to_string(c) + ", rest_deg: 0}\n",
-                             "  - {name: angle, type: coordinate, coordinate: theta}\n", analysis(4.0));
+                             "  - {name: angle, type: coordinate, coordinate: theta}\n"
+                             "  - {name: torque, type: force_value, force: spring}\n", analysis(4.0));
     const std::string from = "theta: {initial: 0}";
-    text.replace(text.find(from), from.size(), "theta: {initial: 0.3}");
+    text.replace(text.find(from), from.size(), "theta: {initial: " + std::to_string(theta0) + "}");
     const Result r = run_text(text);
     const double omega = 4.0, zeta = c / (2 * std::sqrt(8.0 * 0.5)), wd = omega * std::sqrt(1 - zeta * zeta);
     const auto& t = r.column("t");
-    double worst = 0;
+    double worst = 0, worst_torque = 0;
     for (size_t k = 0; k < t.size(); ++k) {
-      const double exact = 0.3 * std::exp(-zeta * omega * t[k]) *
+      const double exact = theta0 * std::exp(-zeta * omega * t[k]) *
                            (std::cos(wd * t[k]) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * t[k]));
       worst = std::max(worst, std::fabs(r.column("angle")[k] - exact));
+      if (c == 0) worst_torque = std::max(worst_torque, std::fabs(r.column("torque")[k] + 8 * exact));
     }
-    EXPECT_LT(worst, 1e-7) << "damping " << c;
+    EXPECT_LT(worst, 1e-7 * theta0 / 0.3) << "damping " << c << ", theta0 " << theta0;
+    EXPECT_LT(worst_torque, 8e-7 * theta0 / 0.3) << "theta0 " << theta0;
   }
 }
 
@@ -301,7 +307,7 @@ TEST(Loads, LoadExpressionErrorsNameTheField) {
   std::string e = errors_of(wheel("  - {name: motor, type: torque, body: wheel, axis: [0, 0, 1], torque: \"T0 * speed\", "
                                   "parameters: {T0: 1}}\n",
                                   "", analysis(1)));
-  EXPECT_NE(e.find("field 'torque': unknown name 'speed'"), std::string::npos) << e;
+  EXPECT_NE(e.find("field 'torque': force 'motor': unknown name 'speed'"), std::string::npos) << e;
   e = errors_of(wheel("  - {name: motor, type: torque, body: wheel, axis: [0, 0, 1], torque: 1, parameters: {t: 1}}\n", "",
                       analysis(1)));
   EXPECT_NE(e.find("field 'parameters.t': 't' is reserved in expressions"), std::string::npos) << e;

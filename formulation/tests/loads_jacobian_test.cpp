@@ -96,12 +96,23 @@ Model loads_model() {
   m.sensors.push_back(sensor("len", T::kForceLength, "spring"));
   m.sensors.push_back(sensor("ten", T::kForceValue, "spring"));
   m.sensors.push_back(sensor("bush", T::kForceValue, "bush_ce"));
+  // Issue 25: angular velocity (world and body axes) and a body's angular momentum about a point.
+  m.sensors.push_back(sensor("spin", T::kAngularVelocity, "e", 2));
+  m.sensors.back().body = "e";
+  m.sensors.push_back(sensor("spin_b", T::kAngularVelocity, "b", 1));
+  m.sensors.back().body = "b";
+  m.sensors.back().body_frame = true;
+  m.sensors.push_back(sensor("mom", T::kAngularMomentum, "c", 0));
+  m.sensors.back().body = "c";
+  m.sensors.back().about = Vec3(0.3, -0.1, 0.2);
+  m.sensors.push_back(sensor("twist", T::kCoordinate, "qa"));
   ForceSpec motor;
   motor.name = "motor";
   motor.type = ForceSpec::Type::kTorque;
   motor.body1 = "d";
   motor.axis = Vec3(0, 0, 1);
-  motor.expression[0] = "T0 * (1 - w / w0) + sin(th) * z + 0.3 * vy * ax - 0.01 * len * ten + 0.02 * bush * t";
+  motor.expression[0] = "T0 * (1 - w / w0) + sin(th) * z + 0.3 * vy * ax - 0.01 * len * ten + 0.02 * bush * t"
+                        " + 0.2 * spin * spin_b - 0.1 * mom + 0.05 * twist";
   motor.parameters = {{"T0", 2.0}, {"w0", 5.0}};
   add(motor);
   ForceSpec push;

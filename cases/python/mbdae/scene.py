@@ -100,17 +100,20 @@ class Scene:
 
     # ---- Running ----------------------------------------------------------------------------
     def run_options(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None):
+        """RunOptions with the command line's range checks (`mbdae run --rtol ...`, cases/field_ranges.h):
+        a value out of range raises ValueError naming the option, as the CLI's message does."""
         opt = _core.RunOptions()
         if rtol is not None:
-            opt.rtol = _positive("rtol", rtol, upper=1.0)
+            opt.rtol = _number("rtol", rtol)
         if atol is not None:
-            opt.atol = _positive("atol", atol, upper=1.0)
+            opt.atol = _number("atol", atol)
         if output_step is not None:
-            opt.output_step = _positive("output_step", output_step)
+            opt.output_step = _number("output_step", output_step)
         if formulation is not None:
-            if formulation not in _core.formulations():
-                raise ValueError(f"formulation expects one of {', '.join(_core.formulations())}, got '{formulation}'")
-            opt.formulation = formulation
+            opt.formulation = str(formulation)
+        errors = _core.option_errors(self._core, opt)
+        if errors:
+            raise ValueError("\n".join(errors))
         if analysis is not None:
             opt.analysis = self._analysis_index(analysis)
         return opt
@@ -233,6 +236,18 @@ def _rebuild(path, text, overrides):
     if not overrides:
         return scene
     return Scene(_scene_errors(_core.with_parameters, scene._core, list(overrides)), path, text, overrides)
+
+
+def _number(name, value):
+    """A finite number for option `name`; 0 (which RunOptions reads as "not given") is refused here,
+    the ranges are the CLI's (checked by _core.option_errors)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number, got {value!r}") from None
+    if v == 0 or not math.isfinite(v):
+        raise ValueError(f"{name}: must be a positive finite number, got {value!r}")
+    return v
 
 
 def _positive(name, value, upper=math.inf):

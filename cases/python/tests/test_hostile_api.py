@@ -1,0 +1,109 @@
+"""Issue 25: the Python API checks what `mbdae run` checks (option ranges, the scene before the
+folder, the folder's lock), with the CLI's words."""
+import fcntl
+import json
+import os
+
+import pytest
+
+import mbdae
+from conftest import STEP, cli_run
+
+WHEEL = """name: wheel
+gravity: [0, 0, 0]
+bodies:
+  - {name: wheel, mass: 1.0, inertia: {xx: 0.3, yy: 0.3, zz: 0.5}}
+joints:
+  - {name: axle, parent: ground, child: wheel, anchor: [0, 0, 0], chain: [R3], coordinates: [theta]}
+coordinates:
+  theta: {initial: 0}
+forces:
+  - {name: motor, type: torque, body: wheel, axis: [0, 0, 1], torque: "TORQUE"}
+sensors:
+  - {name: angle, type: coordinate, coordinate: theta}
+analysis:
+  - {type: dynamics, t_end: 0.2, output_step: 0.01}
+"""
+
+
+def wheel(torque="2"):
+    return mbdae.Scene.from_yaml(WHEEL.replace("TORQUE", torque), "wheel.yaml")
+
+
+@pytest.mark.parametrize("kwargs, option", [
+    ({"rtol": 1e-300}, "rtol"),
+    ({"rtol": 0.9}, "rtol"),
+    ({"rtol": float("nan")}, "rtol"),
+    ({"rtol": "tight"}, "rtol"),
+    ({"atol": -1e-8}, "atol"),
+    ({"atol": 0}, "atol"),
+    ({"output_step": 1e-12}, "output_step"),
+    ({"output_step": -0.1}, "output_step"),
+    ({"output_step": float("inf")}, "output_step"),
+    ({"formulation": "index7"}, "formulation"),
+])
+def test_run_options_are_range_checked_like_the_cli(kwargs, option, tmp_path):
+    """Each bad option raises ValueError naming it before anything runs or is written; the CLI
+    refuses the same value (exit 1) with the same words where it takes the option."""
+    out = tmp_path / "out"
+    with pytest.raises(ValueError) as e:
+        wheel().run(out=out, **kwargs)
+    assert str(e.value).startswith(option + ":"), str(e.value)
+    assert not out.exists()
+    cli = {"rtol": "--rtol", "atol": "--atol", "output_step": "--output-step"}.get(option)
+    value = next(iter(kwargs.values()))
+    if cli and isinstance(value, float) and value not in (0, ) and value == value and abs(value) != float("inf"):
+        scene = tmp_path / "wheel.yaml"
+        scene.write_text(WHEEL.replace("TORQUE", "2"))
+        code, err = cli_run(scene, tmp_path / "cli", cli, repr(value))
+        assert code == 1, err
+        assert str(e.value).split(":", 1)[1].strip() in err, (str(e.value), err)
+
+
+def test_good_options_still_run(tmp_path):
+    r = wheel().run(rtol=1e-8, atol=1e-10, output_step=0.05, out=tmp_path / "out")
+    assert r.ok and r.rows == 5
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"] == "ok"
+
+
+def test_run_out_takes_the_clis_lock(tmp_path):
+    """A folder another run is writing (its lock held) is refused with OSError, and nothing in it
+    is touched (the CLI's exit code 4 case)."""
+    out = tmp_path / "busy"
+    out.mkdir()
+    (out / "summary.json").write_text('{"status": "running"}')
+    fd = os.open(out / ".mbdae.lock", os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(OSError, match="in use by another run"):
+            wheel().run(out=out)
+        assert (out / "summary.json").read_text() == '{"status": "running"}'
+        assert not (out / "results.csv").exists() and not (out / "results.csv.partial").exists()
+    finally:
+        os.close(fd)
+    assert wheel().run(out=out).ok  # free again
+
+
+def test_refused_scene_leaves_the_folder_as_it_was(tmp_path):
+    """A scene refused by the checks of the system (here a load that reads a sensor it may not,
+    found while building it) raises SceneError before the folder is claimed."""
+    out = tmp_path / "out"
+    assert wheel().run(out=out).ok
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    text = WHEEL.replace("TORQUE", "E").replace(
+        "sensors:\n", "sensors:\n  - {name: E, type: kinetic_energy}\n")
+    with pytest.raises(mbdae.SceneError) as e:
+        mbdae.Scene.from_yaml(text, "wheel.yaml").run(out=out)
+    assert e.value.field == "torque" and e.value.line == 10 and "cannot drive a load" in e.value.message
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_nan_load_is_a_solve_error_naming_the_load(tmp_path):
+    with pytest.raises(mbdae.SolveError) as e:
+        wheel("sqrt(0.05 - t)").run(out=tmp_path / "out")
+    assert e.value.status == "non_finite"
+    assert "load 'motor' (torque = sqrt(0.05 - t)) is NaN at t = 0.05" in e.value.message
+    r = e.value.result
+    assert 5 <= r.rows <= 6 and all(t <= 0.05 for t in r["t"])
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "non_finite"
