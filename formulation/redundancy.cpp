@@ -99,6 +99,7 @@ RedundancyReport find_redundant_constraints(const System& sys, const double* q, 
       if (c.type == Constraint::Type::kPoint ? !(c.mask & (1 << comp)) : comp > 0) continue;
       if (dead[off[k] + row]) {
         report.redundant.push_back(row_label(c, row));
+        report.redundant_constraint.push_back(static_cast<int>(k));
       } else {
         keep_mask |= 1 << comp;
       }

@@ -16,6 +16,7 @@ namespace mbdae {
 struct RedundancyReport {
   int equations = 0, rank = 0;
   std::vector<std::string> redundant;  // labels of the redundant equations ("<label> [row k]")
+  std::vector<int> redundant_constraint;  // for each of them, its constraint's index in sys.constraints
   // Per constraint of the analysed system, the rows to keep: a point constraint's component
   // mask (bit k: component k), 1 for other constraints; 0 drops the constraint.
   std::vector<int> keep;

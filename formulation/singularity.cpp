@@ -12,18 +12,24 @@
 namespace mbdae {
 namespace {
 
-// Label and group of each scalar equation (row) of Phi_q.
+// Label and constraint (index in sys.constraints) of each scalar equation (row) of Phi_q.
 struct RowNames {
-  std::vector<std::string> label, group;
+  std::vector<std::string> label;
+  std::vector<int> constraint;
 };
 RowNames row_names(const System& sys) {
   RowNames out;
-  for (const Constraint& c : sys.constraints)
-    for (int r = 0; r < c.rows(); ++r) {
-      out.label.push_back(row_label(c, r));
-      out.group.push_back(constraint_group(c));
+  for (size_t k = 0; k < sys.constraints.size(); ++k)
+    for (int r = 0; r < sys.constraints[k].rows(); ++r) {
+      out.label.push_back(row_label(sys.constraints[k], r));
+      out.constraint.push_back(static_cast<int>(k));
     }
   return out;
+}
+
+// Equation `label` of constraint c with its weight, named by its owner.
+DependentEquation dependent_equation(const Constraint& c, const std::string& label, double weight) {
+  return {label, weight, constraint_group(c), c.owner};
 }
 
 double norm2(const double* x, int n) {
@@ -90,18 +96,16 @@ void name_dependent(const System& sys, const double* q, double t, const std::vec
   const RowNames names = row_names(sys);
   const int nc = report.equations;
   if (report.rank < nc) {
-    System copy = sys;
-    const RedundancyReport rr = find_redundant_constraints(copy, q, t);
-    for (const auto& r : rr.redundant) {
-      const auto it = std::find(names.label.begin(), names.label.end(), r);
-      report.dependent.push_back({r, 1.0, it == names.label.end() ? r : names.group[it - names.label.begin()]});
-    }
+    const RedundancyReport rr = find_redundant_constraints(sys, q, t);
+    for (size_t i = 0; i < rr.redundant.size(); ++i)
+      report.dependent.push_back(dependent_equation(sys.constraints[rr.redundant_constraint[i]], rr.redundant[i], 1.0));
   } else {
     std::vector<int> idx;
     for (int i = 0; i < nc; ++i)
       if (weight[i] >= min_weight) idx.push_back(i);
     std::stable_sort(idx.begin(), idx.end(), [&](int i, int j) { return weight[i] > weight[j]; });
-    for (int i : idx) report.dependent.push_back({names.label[i], weight[i], names.group[i]});
+    for (int i : idx)
+      report.dependent.push_back(dependent_equation(sys.constraints[names.constraint[i]], names.label[i], weight[i]));
   }
   for (const auto& d : report.dependent)
     if (std::find(report.constraints.begin(), report.constraints.end(), d.group) == report.constraints.end())

@@ -24,6 +24,7 @@ struct DependentEquation {
   std::string label;  // the constraint's label ("<label> [x]" for one row of a point constraint)
   double weight = 0;  // |y_i| / max_j |y_j|
   std::string group;  // what it belongs to (constraint_group: "joint rod2_mount", "drive q4")
+  Constraint::Owner owner = Constraint::Owner::kJoint;  // the kind of that owner
 };
 
 struct SingularityReport {

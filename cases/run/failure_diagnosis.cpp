@@ -98,7 +98,7 @@ FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vect
   std::vector<std::string> named;
   for (const auto& d : r.dependent) {
     const std::string& g = d.group;
-    if (d.weight < kNamedWeight || g.rfind("body ", 0) == 0) continue;
+    if (d.weight < kNamedWeight || d.owner == Constraint::Owner::kNorm) continue;
     if (std::find(named.begin(), named.end(), g) == named.end()) named.push_back(g);
   }
   for (size_t i = 0; i < named.size(); ++i) os << (i ? ", " : "") << named[i];
