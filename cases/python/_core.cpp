@@ -75,11 +75,11 @@ py::array column_view(py::object owner, const mbdae::Result& r, size_t k) {
   return std::move(a);
 }
 
-unsigned long main_thread_id() {
-  static const unsigned long id =
-      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
-  return id;
-}
+// The main thread's id, read once when the module is imported. Not a function-local static:
+// its initializer calls into Python, which may hand the GIL to another thread that then waits on
+// the static's guard while holding the GIL (a deadlock seen with two sweep threads).
+unsigned long g_main_thread_id = 0;
+unsigned long main_thread_id() { return g_main_thread_id; }
 
 const char* step_type_name(mbdae::AnalysisStep::Type t) { return mbdae::analysis_type(t).name.c_str(); }
 
@@ -188,6 +188,7 @@ PYBIND11_MODULE(_core, m) {
   m.attr("__version__") = MBDAE_PY_VERSION;  // project(mbdae VERSION ...), cases/python/CMakeLists.txt
   // Scene and model errors as one exception carrying the CLI's lines (file:line: field 'x': ...);
   // the package turns them into mbdae.SceneError with the fields parsed.
+  g_main_thread_id = py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
   static py::exception<mbdae::SceneError> scene_error(m, "SceneErrorLines", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
     auto raise = [](const std::vector<std::string>& lines) { PyErr_SetObject(scene_error.ptr(), py::cast(lines).ptr()); };
