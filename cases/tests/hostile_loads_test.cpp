@@ -69,17 +69,9 @@ analysis:
   return s.str();
 }
 
-class HostileLoads : public ::testing::Test {
+class HostileLoads : public mbdae::test_support::RunFolderTest {
  protected:
-  fs::path dir, out;
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("mbdae_hostile_" + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    out = dir / "out";
-  }
-  void TearDown() override { fs::remove_all(dir); }
+  HostileLoads() : RunFolderTest("mbdae_hostile_") {}
   std::string write(const std::string& name, const std::string& text) {
     std::ofstream(dir / name, std::ios::binary) << text;
     return (dir / name).string();

@@ -95,17 +95,9 @@ long check_whole_rows(const fs::path& csv) {
 
 nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(read_file(p)); }
 
-class OutputFaults : public ::testing::Test {
+class OutputFaults : public mbdae::test_support::RunFolderTest {
  protected:
-  fs::path dir, out;
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("mbdae_faults_" + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    out = dir / "out";
-  }
-  void TearDown() override { fs::remove_all(dir); }
+  OutputFaults() : RunFolderTest("mbdae_faults_") {}
   // The swinging pendulum over [0, t_end]; returns the scene's path.
   std::string scene(const std::string& t_end, const std::string& name = "swing.yaml") {
     std::string text = kSwing;

@@ -4,7 +4,11 @@
 
 #include <sys/wait.h>
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <array>
+#include <filesystem>
 #include <cstdio>
 #include <string>
 
@@ -26,5 +30,24 @@ inline CommandResult run_command(const std::string& cmd) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+// A fresh folder per test (`dir`, removed afterwards) and the run's output folder `out` inside it:
+// the fixture base of the tests that drive the executable. `prefix` keeps suites apart.
+class RunFolderTest : public ::testing::Test {
+ protected:
+  explicit RunFolderTest(std::string prefix) : prefix_(std::move(prefix)) {}
+  std::filesystem::path dir, out;
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() /
+          (prefix_ + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    out = dir / "out";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+
+ private:
+  std::string prefix_;
+};
 
 }  // namespace mbdae::test_support
