@@ -639,14 +639,16 @@ struct Validator {
           if (!sensor_index.count(s.quiet_sensors[k]))
             report(s.where, indexed("quiet_sensors", k), "no sensor named '" + s.quiet_sensors[k] + "'" +
                                                              suggestion(s.quiet_sensors[k], keys(sensor_index)));
-      if (integrates(s))
-        for (size_t k = 0; k < s.error_sensors.size(); ++k)
+      if (integrates(s)) {
+        for (size_t k = 0; k < s.error_sensors.size(); ++k) {
           if (!sensor_index.count(s.error_sensors[k]))
             report(s.where, indexed("error_sensors", k), "no sensor named '" + s.error_sensors[k] + "'" +
                                                              suggestion(s.error_sensors[k], keys(sensor_index)));
           else if (!scene.columns.empty() &&
                    std::find(scene.columns.begin(), scene.columns.end(), s.error_sensors[k]) == scene.columns.end())
             report(s.where, indexed("error_sensors", k), "sensor '" + s.error_sensors[k] + "' is not in the scene's output list");
+        }
+      }
     }
   }
 };
