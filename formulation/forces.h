@@ -5,28 +5,9 @@
 // torque n' in body axes Q_p = 2 L(p)^T n' (the virtual rotation is 2 E dp in world axes, 2 L dp
 // in body axes). Both are linear in p: Q_p = 2 T M(a) p with the constant 4 x 4 matrices
 //   M_world(a) = [0 -a^T; a [a]x],   M_body(a) = [0 -a^T; a -[a]x]   (a the unit axis).
-// Element laws:
-//   spring-damper: tension T = k (Z - Z0) + c dZ/dt between two points, Z their distance;
-//   point force:   f(t) given in world components, or in body axes (a follower force:
-//                  f = A(p) F, so dQ_r/dp = B(p, F), dQ_p/dp = K(s, f) + B(p, s)^T B(p, F));
-//   torque:        magnitude T(t) about a world or body-fixed axis (above);
-//   joint spring-damper: tau = k (q - q0) + c q' on a joint coordinate q(x) with gradient G and
-//                  Hessian H (coordinate_jet): Q = -tau G^T, dQ/dx = -G^T (k G + c (H v)^T) - tau H,
-//                  dQ/dv = -c G^T G; a rotation q counts whole turns (LoadInput::turns, from
-//                  CoordinateTurns: a spring wound 10 rad gives -10 k), or with `wrap` q - q0 is
-//                  wrapped to (-pi, pi] (a spring acting within half a turn of its rest angle);
-//   bushing:       six coordinates y = (d, theta) of frame 2 relative to frame 1, d = C1^T A1^T
-//                  (P2 - P1) and theta = 2 sign(w0) w_vec, w = conj(p1 c1) (p2 c2) the relative
-//                  Euler parameters (c_k the frame's axes in its body): theta is the rotation
-//                  vector to first order (2 sin(phi/2) u exactly). Q = -J^T (K y + C J v), J =
-//                  dy/dx; dQ/dv = -J^T C J exactly, dQ/dx by central differences of Q (step
-//                  1e-6 max(1, |x_k|), truncation and rounding both below 1e-9 relative);
-//   wheel contact: vertical f_z = K_t e when in contact, e = r cos(camber) - (z - z_g(t)), camber
-//                  from the wheel's spin axis u: cos(camber) = sqrt(1 - u_z^2). Whether the wheel
-//                  is in contact is a mode switched by events (root of e), not a max() inside the
-//                  Newton iteration;
-//   user law:      a registered function f(d, d_dot, t, parameters) of the relative position and
-//                  velocity of two points (force on point 1, reaction on point 2).
+// Each force type is a row of the force-type table (formulation/force_types.h) and its law is
+// one file in formulation/forces/ (spring_damper, point_force, torque, joint_spring_damper,
+// bushing, wheel_contact, user_law, ...), whose header comment states the law and its Jacobians.
 // Components given by expressions of sensors (point force, torque) come in a LoadInput computed
 // from the whole state (load_input, formulation/sensors.h) with their gradients; force_eval then
 // returns dQ/d(component) and the caller applies the chain rule (mechanics.cpp).
@@ -74,13 +55,14 @@ void force_eval(const Force& f, const LocalState& pos, const LocalState& vel, do
                 bool in_contact, Vec14& q_local, Mat14* dq_dpos, Mat14* dq_dvel,
                 const LoadInput* input = nullptr, Mat14x3* dq_dinput = nullptr);
 
-// Derivative of the element's generalized force with respect to one of its parameters
-// ("free_length", "stiffness", "damping"), local 14-vector.
+// Derivative of the element's generalized force with respect to one of its solvable parameters
+// (ForceParameter::solvable: "free_length", "stiffness", "damping", "radius"), local 14-vector.
 Vec14 force_parameter_derivative(const Force& f, const LocalState& pos, const LocalState& vel,
                                  double t, bool in_contact, const std::string& parameter);
-double* force_parameter(Force& f, const std::string& parameter);  // nullptr if unknown
+// A parameter of the load's expressions, or of its type's row (ForceParameter); nullptr if unknown.
+double* force_parameter(Force& f, const std::string& parameter);
 
-// Switching function of a wheel contact (its penetration e); elements without one return 0.
+// Switching function (a wheel contact's penetration e); elements without one return 0.
 bool force_has_switch(const Force& f);
 double force_switch_value(const Force& f, const LocalState& pos, double t);
 
@@ -90,7 +72,7 @@ double force_length(const Force& f, const LocalState& pos, double t);
 double force_magnitude(const Force& f, const LocalState& pos, const LocalState& vel, double t,
                        bool in_contact, const LoadInput* input = nullptr);
 // Potential energy stored in a conservative element (spring-damper, joint spring-damper,
-// bushing, wheel contact in contact); 0 for the others.
+// bushing, wheel contact in contact); 0 for the others (their rows have no potential).
 double force_potential(const Force& f, const LocalState& pos, double t, bool in_contact,
                        const LoadInput* input = nullptr);
 

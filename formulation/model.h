@@ -68,13 +68,27 @@ struct CutSpec {
   SourceLocation where;
 };
 
+// A force type: a handle to its row of the force-type table (formulation/force_types.h), which
+// gives its scene fields, parameters, generalized force, potential, events, sensors and glyph.
+// The built-in types have names here; a type added later is found by its scene name
+// (find_force_type) and needs no line in this file.
+struct ForceKind {
+  int id = 0;  // its row in force_types()
+  static const ForceKind kSpringDamper, kPointForce,
+      kTorque,             // applied torque on a body about a world or body-fixed axis
+      kJointSpringDamper,  // torque (force) k (q - q0) + c q' on a joint coordinate q
+      kBushing,            // linear 6-DOF spring-damper between two body frames
+      kWheelContact, kUser;
+  bool operator==(const ForceKind& o) const { return id == o.id; }
+  bool operator!=(const ForceKind& o) const { return id != o.id; }
+};
+inline constexpr ForceKind ForceKind::kSpringDamper{0}, ForceKind::kPointForce{1}, ForceKind::kTorque{2},
+    ForceKind::kJointSpringDamper{3}, ForceKind::kBushing{4}, ForceKind::kWheelContact{5}, ForceKind::kUser{6};
+// Numbers of a force type that has no named field below, placed by its table row.
+inline constexpr int kForceCoefficients = 4;
+
 struct ForceSpec {
-  enum class Type {
-    kSpringDamper, kPointForce, kWheelContact, kUser,
-    kTorque,              // applied torque on a body about a world or body-fixed axis
-    kJointSpringDamper,   // torque (force) k (q - q0) + c q' on a joint coordinate q
-    kBushing              // linear 6-DOF spring-damper between two body frames
-  };
+  using Type = ForceKind;
   std::string name;
   Type type = Type::kSpringDamper;
   std::string body1, point1, body2, point2;
@@ -107,6 +121,7 @@ struct ForceSpec {
   // User force law: registered name and numeric parameters. Expression loads: named constants.
   std::string law;
   std::map<std::string, double> parameters;
+  double coefficient[kForceCoefficients] = {0, 0, 0, 0};  // see kForceCoefficients
   SourceLocation where;
 };
 

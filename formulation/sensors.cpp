@@ -5,16 +5,18 @@
 #include <string>
 
 #include "core/finite_check.h"
+#include "formulation/force_types.h"
 #include "formulation/forces.h"
 
 namespace mbdae {
 
 std::string load_field(const Force& f, int c) {
-  return f.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+  const char* field = force_type(f.type).components[c];
+  return field ? field : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
 }
 
 double joint_turns(const System& sys, const Force& f, const double* q, double t, const CoordinateTurns* turns) {
-  if (f.type != ForceSpec::Type::kJointSpringDamper || f.wrap || f.coordinate_index < 0) return 0.0;
+  if (force_type(f.type).attach != ForceAttach::kCoordinate || f.wrap || f.coordinate_index < 0) return 0.0;
   const double raw = coordinate_value(sys, f.coordinate_index, q);
   return continuous_coordinate(sys, f.coordinate_index, raw, t, turns) - raw;
 }

@@ -34,7 +34,8 @@ LoadInput load_input(const System& sys, const Force& f, const std::vector<char>&
                      const CoordinateTurns* turns = nullptr);
 // The scene field of expression component c of load f: "torque", "fx", "fy" or "fz".
 std::string load_field(const Force& f, int c);
-// 2 pi times the whole turns of joint spring-damper f's coordinate (0 for other loads and `wrap`).
+// 2 pi times the whole turns of the coordinate of a load on a joint coordinate (ForceAttach::
+// kCoordinate: joint spring-damper, ...); 0 for other loads and with `wrap`.
 double joint_turns(const System& sys, const Force& f, const double* q, double t, const CoordinateTurns* turns);
 
 }  // namespace mbdae

@@ -69,6 +69,7 @@ struct Force {
   bool wrap = false;
   // Bushing: stiffness and damping per frame-1 axis (si, sj: the frames' origins).
   Vec3 kt = Vec3::Zero(), ct = Vec3::Zero(), kr = Vec3::Zero(), cr = Vec3::Zero();
+  double coefficient[kForceCoefficients] = {0, 0, 0, 0};  // the type's other numbers (model.h)
   // Components given by expressions (empty: fx, fy, fz). Their variables are t (index 0), the
   // parameters (1 ...) and then the values of the sensors `inputs` (indices into System::sensors);
   // `reads` lists the bodies those sensors depend on (ascending, at most kMaxLoadReads).

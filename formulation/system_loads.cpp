@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "core/expression.h"
+#include "formulation/force_types.h"
 #include "formulation/forces.h"
 #include "formulation/system_build.h"
 
@@ -21,8 +22,11 @@ int find_name(const NameIndex& names, const std::string& n) {
 }
 
 // Fields of the loads of issue 13: torque axis, bushing stiffness and damping, the coordinate of
-// a joint spring-damper, named parameters of expression loads.
+// a load on a joint coordinate, named parameters of expression loads; the numbers of its row.
 void add_load_fields(const ForceSpec& fs, const System& sys, const NameIndex& coordinate_of, Force& f) {
+  const ForceType& row = force_type(fs.type);
+  for (const ForceParameter& p : row.parameters)  // the accessor only takes the address
+    *p.value(f) = *p.spec(const_cast<ForceSpec&>(fs));
   if (fs.type == ForceSpec::Type::kTorque && !fs.body_frame) f.axis = fs.axis.normalized();
   f.kt = fs.translational_stiffness;
   f.ct = fs.translational_damping;
@@ -30,7 +34,7 @@ void add_load_fields(const ForceSpec& fs, const System& sys, const NameIndex& co
   f.cr = fs.rotational_damping;
   if (fs.type == ForceSpec::Type::kBushing && f.bi == f.bj)
     fail(fs.where, "body2", "bushing '" + fs.name + "' joins two parts of the same rigid body");
-  if (fs.type == ForceSpec::Type::kJointSpringDamper) {
+  if (row.attach == ForceAttach::kCoordinate) {
     const int k = find_name(coordinate_of, fs.coordinate);
     if (k < 0) fail(fs.where, "coordinate", "no joint coordinate named '" + fs.coordinate + "'");
     if (sys.coordinates[k].merged)
@@ -101,7 +105,8 @@ void resolve_load_expressions(const ForceSpec& fs, const System& sys, const Name
       fail(fs.where, "parameters." + pname, "'" + pname + "' is reserved in expressions (" + Expression::reserved_list() + ")");
   for (int c = 0; c < 3; ++c) {
     if (fs.expression[c].empty()) continue;
-    const char* field = fs.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+    const char* field = force_type(fs.type).components[c];
+    if (!field) field = c == 0 ? "fx" : c == 1 ? "fy" : "fz";
     try {
       f.expression[c] = Expression::compile(fs.expression[c], [&](const std::string& n) {
         return load_variable(sys, sensor_of, is_expression_load, n, f);
@@ -136,12 +141,12 @@ void add_forces(const ModelIndex& index, System& sys, const NameIndex& coordinat
       if (at_xyz) p.second = p.first->local_point(xyz);
       return p;
     };
-    const bool on_coordinate = fs.type == ForceSpec::Type::kJointSpringDamper;  // no body point
+    const ForceAttach attach = force_type(fs.type).attach;
+    const bool on_coordinate = attach == ForceAttach::kCoordinate;  // no body point
     auto [b1, p1] = located(on_coordinate ? kGround : fs.body1, fs.point1, fs.at_xyz1, fs.xyz1, "body1");
     f.bi = b1->body;
     f.si = p1;
-    if (fs.type == ForceSpec::Type::kSpringDamper || fs.type == ForceSpec::Type::kUser ||
-        fs.type == ForceSpec::Type::kBushing) {
+    if (attach == ForceAttach::kTwoPoints) {
       auto [b2, p2] = located(fs.body2, fs.point2, fs.at_xyz2, fs.xyz2, "body2");
       f.bj = b2->body;
       f.sj = p2;

@@ -12,6 +12,7 @@
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/euler_parameters.h"
+#include "formulation/force_types.h"
 #include "formulation/forces.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
@@ -224,13 +225,15 @@ void draw_constraints(const AnimationPlan& plan, const double* q, Painter& pt) {
             static_cast<int>(c));
 }
 
-// Spring-dampers, bushings and user laws as lines carrying their force; point and contact forces
-// as vectors (point field force_vector) at their points. Torques and joint springs are not drawn.
+// Each force as its row's glyph (formulation/force_types.h): spring-dampers, bushings and user
+// laws as lines carrying their force; point and contact forces as vectors (point field
+// force_vector) at their points; torques and loads on joint coordinates not at all.
 void draw_forces(const System& sys, const double* q, const double* v, const std::vector<char>& modes, double t,
                  Painter& pt) {
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
-    if (f.type == ForceSpec::Type::kTorque || f.type == ForceSpec::Type::kJointSpringDamper) continue;  // no line
+    const ForceGlyph glyph = force_type(f.type).glyph;
+    if (glyph == ForceGlyph::kNone) continue;
     LoadInput in;
     const bool evaluate = v != nullptr;  // null: only the frame's layout is wanted (its size)
     if (evaluate && f.has_expression()) in = load_input(sys, f, modes, q, v, t, false);
@@ -238,13 +241,13 @@ void draw_forces(const System& sys, const double* q, const double* v, const std:
     const double value = evaluate ? force_magnitude(f, x, xd, t, modes[k], &in) : 0.0;
     const Vec3 xi = world({f.bi, f.si}, q);
     const int index = static_cast<int>(k);
-    if (f.type == ForceSpec::Type::kPointForce || f.type == ForceSpec::Type::kWheelContact) {
+    if (glyph == ForceGlyph::kVector || glyph == ForceGlyph::kWheel) {
       // The world force is the translational part of its generalized force on its body.
       Vec14 generalized = Vec14::Zero();
       if (evaluate) force_eval(f, x, xd, t, modes[k], generalized, nullptr, nullptr, &in);
-      const Vec3 vec = f.type == ForceSpec::Type::kPointForce ? Vec3(generalized.head<3>()) : Vec3(0, 0, value);
+      const Vec3 vec = glyph == ForceGlyph::kVector ? Vec3(generalized.head<3>()) : Vec3(0, 0, value);
       pt.cell(pt.data.verts, {pt.add_point(xi, vec)}, AnimationPart::kForceVector, -1, index, -1, value);
-      if (f.type == ForceSpec::Type::kWheelContact) {
+      if (glyph == ForceGlyph::kWheel) {
         const Vec3 below(xi.x(), xi.y(), f.ground.value(t));
         const int a = pt.add_point(below - f.radius * Vec3::UnitX()), b = pt.add_point(below + f.radius * Vec3::UnitX());
         pt.cell(pt.data.lines, {a, b}, AnimationPart::kGround, -1, index);

@@ -1,4 +1,5 @@
-// Reading forces (one row of force_types() per force type) and their fields.
+// Reading forces: the fields of each type from its row of the force-type table
+// (formulation/force_types.h), read here by the type's reader or from the row alone.
 #include "cases/scene/loader.h"
 
 #include <algorithm>
@@ -97,7 +98,7 @@ void Loader::two_points(const YAML::Node& n, ForceSpec& f) {
 }
 
 
-// The fields of each force type (the table force_types() below lists the types).
+// The readers of the built-in types (force_readers() below).
 void Loader::spring_damper(const YAML::Node& n, ForceSpec& f) {
   two_points(n, f);
   non_negative(n, "stiffness", f.stiffness, true);
@@ -161,50 +162,70 @@ void Loader::user_force(const YAML::Node& n, ForceSpec& f) {
   force_parameters(n, f);
 }
 
-const std::vector<Loader::ForceType>& Loader::force_types() {
-  using T = ForceSpec::Type;
-  static const std::vector<ForceType> table = {
-      {"spring_damper", T::kSpringDamper,
-       {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "free_length"},
-       &Loader::spring_damper},
-      {"point_force", T::kPointForce, {"name", "type", "body", "point", "fx", "fy", "fz", "frame", "parameters"},
-       &Loader::point_force},
-      {"torque", T::kTorque, {"name", "type", "body", "axis", "frame", "torque", "parameters"}, &Loader::torque},
-      {"joint_spring_damper", T::kJointSpringDamper,
-       {"name", "type", "coordinate", "stiffness", "damping", "rest", "rest_deg", "wrap"}, &Loader::joint_spring_damper},
-      {"bushing", T::kBushing,
-       {"name", "type", "body1", "point1", "body2", "point2", "stiffness", "damping", "rotational_stiffness",
-        "rotational_damping"},
-       &Loader::bushing},
-      {"wheel_contact", T::kWheelContact, {"name", "type", "body", "point", "stiffness", "radius", "axis", "ground"},
-       &Loader::wheel_contact},
-      {"user", T::kUser, {"name", "type", "body1", "point1", "body2", "point2", "law", "parameters"},
-       &Loader::user_force},
-  };
-  return table;
+void Loader::table_force(const YAML::Node& n, const ForceType& row, ForceSpec& f) {
+  switch (row.attach) {
+    case ForceAttach::kTwoPoints: two_points(n, f); break;
+    case ForceAttach::kBodyPoint:
+      f.body1 = name(n, "body");
+      body_point(n, "point", f.point1, f.xyz1, f.at_xyz1);
+      break;
+    case ForceAttach::kBody: f.body1 = name(n, "body"); break;
+    case ForceAttach::kCoordinate: f.coordinate = name(n, "coordinate"); break;
+  }
+  for (const ForceParameter& p : row.parameters) {
+    const auto x = opt_number(n, p.name, p.required);
+    if (!x) continue;
+    *p.spec(f) = *x;
+    if (p.range == ParameterRange::kNonNegative && *x < 0)
+      error(n[p.name], p.name, "must not be negative, got " + format_number(*x));
+    if (p.range == ParameterRange::kPositive && !(*x > 0))
+      error(n[p.name], p.name, "must be positive, got " + format_number(*x));
+  }
 }
 
+const std::map<std::string, Loader::ForceReader>& Loader::force_readers() {
+  static const std::map<std::string, ForceReader> readers = {
+      {"spring_damper", &Loader::spring_damper}, {"point_force", &Loader::point_force},
+      {"torque", &Loader::torque}, {"joint_spring_damper", &Loader::joint_spring_damper},
+      {"bushing", &Loader::bushing}, {"wheel_contact", &Loader::wheel_contact}, {"user", &Loader::user_force}};
+  return readers;
+}
+
+namespace {
+// Every field of some force type: the built-in ones in the order messages have always listed
+// them, then those of types added to the table since.
+const Fields& general_force_fields() {
+  static const Fields general = [] {
+    Fields g = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
+                "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
+                "ground", "law", "parameters", "frame", "torque", "coordinate", "rest",
+                "rest_deg", "rotational_stiffness", "rotational_damping", "wrap"};
+    for (const ForceType* t : force_types())
+      for (const std::string& field : t->fields)
+        if (!contains(g, field)) g.push_back(field);
+    return g;
+  }();
+  return general;
+}
+}  // namespace
 
 void Loader::force(const YAML::Node& n, Model& m) {
-  static const Fields general = {"name", "type", "body1", "point1", "body2", "point2", "body", "point",
-                                 "stiffness", "damping", "free_length", "fx", "fy", "fz", "radius", "axis",
-                                 "ground", "law", "parameters", "frame", "torque", "coordinate", "rest",
-                                 "rest_deg", "rotational_stiffness", "rotational_damping", "wrap"};
+  const Fields& general = general_force_fields();
   if (!check_keys(n, "force", general)) return;
   ForceSpec f;
   f.where = where(n);
   f.name = name(n);
   const std::string type = text(n, "type", "", true);
-  const auto& types = force_types();
-  const auto it = std::find_if(types.begin(), types.end(), [&](const ForceType& t) { return type == t.name; });
-  if (it != types.end()) {
-    applies(n, "a " + type + " force", general, it->fields);
-    f.type = it->type;
-    (this->*(it->read))(n, f);
+  const ForceKind kind = find_force_type(type);
+  if (kind.id >= 0) {
+    const ForceType& row = force_type(kind);
+    applies(n, "a " + type + " force", general, row.fields);
+    f.type = kind;
+    const auto reader = force_readers().find(type);
+    if (reader != force_readers().end()) (this->*(reader->second))(n, f);
+    else table_force(n, row, f);
   } else if (!type.empty()) {
-    std::string names;
-    for (const ForceType& t : types) names += (names.empty() ? "" : ", ") + std::string(t.name);
-    error(n["type"], "type", "unknown force type " + quote(type) + " (" + names + ")");
+    error(n["type"], "type", "unknown force type " + quote(type) + " (" + force_type_names() + ")");
   }
   m.forces.push_back(f);
 }

@@ -16,6 +16,7 @@
 #include "cases/scene/scene.h"
 #include "cases/scene/scene_overrides.h"
 #include "cases/scene/scene_validation.h"
+#include "formulation/force_types.h"
 
 namespace mbdae::scene_load {
 
@@ -126,7 +127,7 @@ struct Loader {
   void positive(const YAML::Node& n, const char* key, double& out);
   void two_points(const YAML::Node& n, ForceSpec& f);
 
-  // The fields of each force type (the table force_types() below lists the types).
+  // The readers of the built-in force types (force_readers() below).
   void spring_damper(const YAML::Node& n, ForceSpec& f);
   void point_force(const YAML::Node& n, ForceSpec& f);
   void torque(const YAML::Node& n, ForceSpec& f);
@@ -135,13 +136,13 @@ struct Loader {
   void wheel_contact(const YAML::Node& n, ForceSpec& f);
   void user_force(const YAML::Node& n, ForceSpec& f);
 
-  struct ForceType {
-    const char* name;
-    ForceSpec::Type type;
-    Fields fields;  // the fields that apply to it
-    void (Loader::*read)(const YAML::Node&, ForceSpec&);
-  };
-  static const std::vector<ForceType>& force_types();
+  // A type of the force-type table (formulation/force_types.h) without a reader here: its
+  // attachment (bodies and points, or a coordinate) and its parameters, checked by their ranges.
+  void table_force(const YAML::Node& n, const ForceType& row, ForceSpec& f);
+  // The readers of the built-in types whose fields need more than their row (expression
+  // components, rest_deg, 3-vectors, ...), by type name; the row lists the fields of every type.
+  using ForceReader = void (Loader::*)(const YAML::Node&, ForceSpec&);
+  static const std::map<std::string, ForceReader>& force_readers();
 
   void force(const YAML::Node& n, Model& m);
 

@@ -4,6 +4,8 @@
 #include <cctype>
 #include <map>
 
+#include "formulation/force_types.h"
+
 namespace mbdae {
 namespace {
 
@@ -21,14 +23,14 @@ std::string function_unit(const std::string& field, const std::string& u) {
 
 std::string force_unit(const std::vector<std::string>& segs, const std::string& type, char kind) {
   const std::string& f = segs.size() > 2 ? segs[2] : "";
-  const bool rot = kind == 'R';
-  if (type == "joint_spring_damper") {
-    if (f == "stiffness") return rot ? "N m/rad" : kind == 'T' ? "N/m" : "";
-    if (f == "damping") return rot ? "N m s/rad" : kind == 'T' ? "N s/m" : "";
-    if (f == "rest") return rot ? "rad" : kind == 'T' ? "m" : "";
-    if (f == "rest_deg") return "deg";
-    return "";
+  // The parameters of the type's row (formulation/force_types.h); on a coordinate, by its kind.
+  const ForceKind k = find_force_type(type);
+  const ForceType* row = k.id >= 0 ? &force_type(k) : nullptr;
+  if (const ForceParameter* p = row ? find_force_parameter(*row, f) : nullptr) {
+    if (row->attach != ForceAttach::kCoordinate) return p->unit;
+    return kind == 'R' ? p->unit : kind == 'T' ? p->unit_translation : "";
   }
+  if (row && row->attach == ForceAttach::kCoordinate) return f == "rest_deg" ? "deg" : "";
   if (f == "stiffness") return "N/m";
   if (f == "damping") return "N s/m";
   if (f == "rotational_stiffness") return "N m/rad";

@@ -6,6 +6,7 @@
 #include "cases/scene/analysis_types.h"
 #include "core/errors.h"
 #include "core/expression.h"
+#include "formulation/force_types.h"
 #include "formulation/forces.h"
 #include "formulation/joint_tree.h"
 
@@ -348,31 +349,25 @@ struct Validator {
         if (!fresh)
           report(f.where, "name", "force '" + f.name + "' is defined twice (first at " + at(it->second->where, f.where) + ")");
       }
-      switch (f.type) {
-        case ForceSpec::Type::kSpringDamper:
-        case ForceSpec::Type::kUser:
+      switch (force_type(f.type).attach) {  // the references of its row's attachment
+        case ForceAttach::kTwoPoints:
           check_point(f.where, who, "body1", f.body1, "point1", f.point1);
           check_point(f.where, who, "body2", f.body2, "point2", f.point2);
-          break;
-        case ForceSpec::Type::kBushing:
-          check_point(f.where, who, "body1", f.body1, "point1", f.point1);
-          check_point(f.where, who, "body2", f.body2, "point2", f.point2);
-          if (!f.body1.empty() && !f.body2.empty() && known_body(f.body1) && known_body(f.body2) &&
-              same_rigid_body(f.body1, f.body2))
+          if (f.type == ForceSpec::Type::kBushing && !f.body1.empty() && !f.body2.empty() && known_body(f.body1) &&
+              known_body(f.body2) && same_rigid_body(f.body1, f.body2))
             report(f.where, "body2", who + "a bushing between two parts of the same rigid body");
           break;
-        case ForceSpec::Type::kPointForce:
-        case ForceSpec::Type::kWheelContact:
-        case ForceSpec::Type::kTorque:
+        case ForceAttach::kBodyPoint:
+        case ForceAttach::kBody:
           check_point(f.where, who, "body", f.body1, "point", f.point1);
-          if (f.type != ForceSpec::Type::kWheelContact && !f.body1.empty() && known_body(f.body1) &&
-              same_rigid_body(f.body1, kGround)) {
+          if ((f.type == ForceSpec::Type::kPointForce || f.type == ForceSpec::Type::kTorque) && !f.body1.empty() &&
+              known_body(f.body1) && same_rigid_body(f.body1, kGround)) {
             const std::string what = f.type == ForceSpec::Type::kTorque ? "a torque" : "a point force";
             report(f.where, "body", who + (f.body1 == kGround ? what + " on ground does nothing (ground does not move); apply it to a moving body"
                                                               : what + " on '" + f.body1 + "', which is fixed to ground (its joints to ground are locked or welds), does nothing"));
           }
           break;
-        case ForceSpec::Type::kJointSpringDamper:
+        case ForceAttach::kCoordinate:
           if (!f.coordinate.empty() && !joint_of_coordinate.count(f.coordinate))
             report(f.where, "coordinate", who + "no joint coordinate named '" + f.coordinate + "'" +
                                               suggestion(f.coordinate, keys(joint_of_coordinate)));
@@ -466,7 +461,8 @@ struct Validator {
                                                    "it would hide the sensor); rename one of them");
       for (int c = 0; c < 3; ++c) {
         if (f.expression[c].empty()) continue;
-        const std::string field = f.type == ForceSpec::Type::kTorque ? "torque" : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
+        const char* component = force_type(f.type).components[c];
+        const std::string field = component ? component : c == 0 ? "fx" : c == 1 ? "fy" : "fz";
         check_load_expression(f, who, field, f.expression[c], expression_loads);
       }
     }
@@ -601,9 +597,9 @@ struct Validator {
             report(s.where, f, "no force named '" + fname + "'" + suggestion(fname, keys(forces)));
             continue;
           }
-          std::vector<std::string> params;
-          if (it->second->type == ForceSpec::Type::kSpringDamper) params = {"free_length", "stiffness", "damping"};
-          if (it->second->type == ForceSpec::Type::kWheelContact) params = {"stiffness", "radius"};
+          std::vector<std::string> params;  // its row's solvable parameters
+          for (const ForceParameter& fp : force_type(it->second->type).parameters)
+            if (fp.solvable) params.push_back(fp.name);
           if (std::find(params.begin(), params.end(), p) == params.end()) {
             std::string list;
             for (const auto& x : params) list += (list.empty() ? "" : ", ") + x;
