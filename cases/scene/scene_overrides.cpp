@@ -10,6 +10,7 @@
 #include "cases/scene/parameter_units.h"
 #include "cases/scene/scene.h"
 #include "core/errors.h"
+#include "formulation/force_types.h"
 
 namespace mbdae {
 namespace {
@@ -252,7 +253,9 @@ std::vector<ParameterEntry> list_parameters(YAML::Node scene, const std::string&
     char kind = '?';
     if (segs[0] == "coordinates" && segs.size() > 1) kind = coordinate_kind(scene, segs[1]);
     if (kind == '?' && model && segs[0] == "coordinates" && segs.size() > 1) kind = coordinate_kind(*model, segs[1]);
-    if (segs[0] == "forces" && type == "joint_spring_damper" && item["coordinate"] && item["coordinate"].IsScalar()) {
+    const ForceKind force_kind = find_force_type(type);  // a load on a coordinate: units by its kind
+    if (segs[0] == "forces" && force_kind.id >= 0 && force_type(force_kind).attach == ForceAttach::kCoordinate &&
+        item["coordinate"] && item["coordinate"].IsScalar()) {
       kind = coordinate_kind(scene, item["coordinate"].Scalar());
       if (kind == '?' && model) kind = coordinate_kind(*model, item["coordinate"].Scalar());
     }
