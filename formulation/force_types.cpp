@@ -14,6 +14,7 @@ const ForceType& joint_spring_damper_type();
 const ForceType& bushing_type();
 const ForceType& wheel_contact_type();
 const ForceType& user_force_type();
+const ForceType& joint_friction_type();
 
 const std::vector<const ForceType*>& force_types() {
   // In ForceKind order (the built-in kinds of model.h are the indices of the first seven rows),
@@ -21,6 +22,7 @@ const std::vector<const ForceType*>& force_types() {
   static const std::vector<const ForceType*> table = {
       &spring_damper_type(), &point_force_type(), &torque_type(), &joint_spring_damper_type(),
       &bushing_type(), &wheel_contact_type(), &user_force_type(),
+      &joint_friction_type(),
   };
   return table;
 }

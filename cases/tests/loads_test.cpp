@@ -8,7 +8,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "cases/mbdae.h"
 #include "core/errors.h"
@@ -267,6 +270,52 @@ analysis:
   EXPECT_LT(worst, 1e-7);
 }
 
+// Joint friction (formulation/forces/joint_friction.cpp), tau = -F tanh(w / w_s), spinning the
+// wheel down from w0 = 10 rad/s with F = 1 N m, J = 0.5, w_s = 0.05 rad/s. Then J w' = -F tanh(w / w_s)
+// has the closed form sinh(w / w_s) = sinh(w0 / w_s) exp(-F t / (J w_s)): w = w0 - (F / J) t
+// while w >> w_s, at rest (not reversed) after t* = J w0 / F = 5 s, and the total angle is
+// (J / F) (w0^2 / 2 + w_s^2 pi^2 / 12) (the integral of w coth(w / w_s) dw).
+TEST(Loads, JointFrictionSpinsAWheelDownToRest) {
+  const double w0 = 10, friction = 1, slip = 0.05, inertia = 0.5;
+  for (const char* form : kFormulations) {
+    SCOPED_TRACE(form);
+    const Result r = run_text(
+        wheel("  - {name: drag, type: joint_friction, coordinate: theta, friction: 1, slip_rate: 0.05}\n",
+              "  - {name: angle, type: coordinate, coordinate: theta}\n"
+              "  - {name: rate, type: coordinate_rate, coordinate: theta}\n"
+              "  - {name: torque, type: force_value, force: drag}\n",
+              std::string("analysis:\n  - {type: assembly, hold: [theta]}\n"
+                          "  - {type: dynamics, t_end: 6, output_step: 0.05, rtol: 1.0e-10, atol: 1.0e-12, formulation: ") +
+                  form + ", initial_velocities: {theta: 10}}\n"));
+    const auto& t = r.column("t");
+    const auto& angle = r.column("angle");
+    const auto& rate = r.column("rate");
+    const auto& torque = r.column("torque");
+    ASSERT_GT(t.size(), 100u);
+    double worst_rate = 0, worst_angle = 0, lowest = 0;
+    for (size_t k = 0; k < t.size(); ++k) {
+      const double log_y = std::log(std::sinh(w0 / slip)) - friction * t[k] / (inertia * slip);
+      const double exact = slip * std::asinh(std::exp(log_y));
+      worst_rate = std::max(worst_rate, std::fabs(rate[k] - exact));
+      lowest = std::min(lowest, rate[k]);
+      if (k > 0) EXPECT_LE(rate[k], rate[k - 1] + 1e-9) << t[k];  // never speeds up
+      EXPECT_NEAR(torque[k], -friction * std::tanh(rate[k] / slip), 1e-12) << t[k];
+      if (t[k] <= 4.5)  // w >= 1 rad/s = 20 w_s: Coulomb's constant deceleration
+        worst_angle = std::max(worst_angle, std::fabs(angle[k] - (w0 * t[k] - friction * t[k] * t[k] / (2 * inertia))));
+    }
+    const double total = inertia / friction * (w0 * w0 / 2 + slip * slip * M_PI * M_PI / 12);
+    EXPECT_LT(worst_rate, 1e-6);
+    EXPECT_LT(worst_angle, 1e-6);
+    EXPECT_GT(lowest, -1e-9);  // comes to rest, does not reverse
+    EXPECT_NEAR(angle.back(), total, 1e-6);
+    EXPECT_LT(std::fabs(rate.back()), 1e-9);
+    char figures[96];
+    std::snprintf(figures, sizeof figures, "%.2e rad/s, %.2e rad, %.2e rad", worst_rate, worst_angle,
+                  std::fabs(angle.back() - total));
+    RecordProperty(std::string("rate_angle_total_errors_") + form, figures);
+  }
+}
+
 // ---- Loader messages -------------------------------------------------------------------------
 
 std::string errors_of(const std::string& text) {
@@ -313,6 +362,30 @@ TEST(Loads, LoadExpressionErrorsNameTheField) {
   EXPECT_NE(e.find("field 'parameters.t': 't' is reserved in expressions"), std::string::npos) << e;
   e = errors_of(wheel("  - {name: spring, type: joint_spring_damper, coordinate: phi, stiffness: 1}\n", "", analysis(1)));
   EXPECT_NE(e.find("no joint coordinate named 'phi'"), std::string::npos) << e;
+}
+
+// Hostile joint friction fields: each message names the file, the line and the field.
+TEST(Loads, JointFrictionFieldsAreChecked) {
+  auto message = [](const std::string& force) {
+    const std::string text = wheel(force, "", analysis(1));
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find("name: drag")), '\n'));
+    return std::make_pair(errors_of(text), "loads_test.yaml:" + std::to_string(line) + ": field ");
+  };
+  auto [e, at] = message("  - {name: drag, type: joint_friction, coordinate: theta, friction: -2, slip_rate: 0.1}\n");
+  EXPECT_NE(e.find(at + "'friction': must not be negative, got -2"), std::string::npos) << e;
+  std::tie(e, at) = message("  - {name: drag, type: joint_friction, coordinate: theta, friction: 2, slip_rate: 0}\n");
+  EXPECT_NE(e.find(at + "'slip_rate': must be positive, got 0"), std::string::npos) << e;
+  std::tie(e, at) = message("  - {name: drag, type: joint_friction, friction: 2, slip_rate: 0.1}\n");
+  EXPECT_NE(e.find(at + "'coordinate': "), std::string::npos) << e;
+  std::tie(e, at) = message("  - {name: drag, type: joint_friction, coordinate: theta, slip_rate: 0.1}\n");
+  EXPECT_NE(e.find(at + "'friction': "), std::string::npos) << e;
+  std::tie(e, at) = message("  - {name: drag, type: joint_friction, coordinate: phi, friction: 2, slip_rate: 0.1}\n");
+  EXPECT_NE(e.find(at + "'coordinate': force 'drag': no joint coordinate named 'phi'"), std::string::npos) << e;
+  std::tie(e, at) = message("  - {name: drag, type: joint_friction, coordinate: theta, friction: 2, slip_rate: 0.1, stiffness: 3}\n");
+  EXPECT_NE(e.find(at + "'stiffness': does not apply to a joint_friction force (its fields: name, type, coordinate, "
+                        "friction, slip_rate)"),
+            std::string::npos)
+      << e;
 }
 
 }  // namespace

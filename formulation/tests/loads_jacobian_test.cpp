@@ -4,6 +4,7 @@
 // expression loads to the bodies their sensors read).
 #include <gtest/gtest.h>
 
+#include "formulation/force_types.h"
 #include "formulation/forces.h"
 #include "formulation/index3_dae.h"
 #include "formulation/mechanics.h"
@@ -210,6 +211,47 @@ TEST(LoadsJacobian, LoadExpressionsAreChecked) {
   m = loads_model();
   m.sensors.push_back(sensor("pi", SensorSpec::Type::kCoordinate, "qa"));
   EXPECT_NE(message(m).find("reserved"), std::string::npos) << message(m);
+}
+
+// The worked example of the force-type table (formulation/forces/joint_friction.cpp): smooth
+// Coulomb friction on rotation and translation coordinates, slip rates at which the random rates
+// (order 1) fall on the curved part of tanh, against central differences: each element's
+// Jacobians and the whole index-3 Newton matrix.
+Model friction_model() {
+  Model m = testing::all_types_model();
+  double level = 2.0;
+  for (const char* c : {"qa", "qb2", "qd", "qe2", "qf1"}) {
+    ForceSpec j;
+    j.name = std::string("friction_") + c;
+    j.type = find_force_type("joint_friction");
+    j.coordinate = c;
+    j.coefficient[0] = level;  // friction
+    j.coefficient[1] = 0.7;    // slip_rate
+    level += 0.5;
+    m.forces.push_back(j);
+  }
+  return m;
+}
+
+TEST(LoadsJacobian, JointFrictionJacobiansMatchFiniteDifferences) {
+  const System sys = build_system(friction_model());
+  int checked = 0;
+  for (unsigned seed : {11u, 12u, 13u}) {
+    const RandomState st = random_state(sys, seed);
+    for (const Force& f : sys.forces) {
+      if (f.type != find_force_type("joint_friction")) continue;
+      const testing::ForceCheck check =
+          testing::check_force_jacobians(f, gather(st.q.data(), f.bi, f.bj), gather(st.v.data(), f.bi, f.bj));
+      EXPECT_GT(check.force_norm, 0) << f.name;
+      EXPECT_LT(check.worst, 1e-6) << check.where;
+      RecordProperty("worst_relative_error_" + f.name + "_" + std::to_string(seed), testing::sci(check.worst));
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 15);
+  Index3Dae dae(sys, 7.0);
+  const testing::NewtonCheck check = testing::check_newton_matrix(dae, random_state(sys, 14), false);
+  EXPECT_LT(check.worst, 1e-6) << check.where;
 }
 
 }  // namespace
