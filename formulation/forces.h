@@ -34,7 +34,8 @@ struct UserForceLaw {
                      Mat3& df_dd, Mat3& df_dddot)>
       jacobian;  // optional
 };
-// The law named `name` from the immutable table in forces.cpp (safe from any thread), or null.
+// The law named `name` from the immutable table in formulation/forces/user_law.cpp (safe from any
+// thread), or null.
 const UserForceLaw* find_force_law(const std::string& name);
 
 

@@ -49,11 +49,13 @@ double kinetic_energy(const System& sys, const double* q, const double* v) {
 //   wheel_contact    V = 1/2 K e^2 when in contact       (e = r cos(camber) - (z - z_g(t)), the
 //                    (mode) and 0 otherwise               penetration of force_switch_value)
 //   joint_spring_damper  V = 1/2 k w(q - q0)^2        (w: wrapped to (-pi, pi] for rotations)
-//   bushing          V = 1/2 y^T K y                     (y = (d, theta), forces.h)
+//   bushing          V = 1/2 y^T K y                     (y = (d, theta), forces/bushing.cpp)
 //   point_force, torque  nothing (imposed loads, not derived from a potential)
+//   joint_friction   nothing (dissipative)
 //   user laws        nothing: a registered law is an arbitrary f(d, d_dot, t) with no potential
 //                    known to the engine (linear_bushing's 1/2 k |d|^2 is left out as well),
 //                    so energy balances of models with user forces must account for them.
+// Each load's term comes from its row of the force-type table (ForceType::potential).
 // The wheel-contact term is the exact potential of the applied force only while the camber and
 // the ground height are constant: the force is vertical, K e, at the wheel centre, which is the
 // gradient of 1/2 K e^2 with respect to the centre height alone (a moving ground does work).

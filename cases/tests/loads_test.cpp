@@ -189,7 +189,7 @@ TEST(Loads, TorsionalPendulum) {
 // centre of mass: under gravity from the unstressed pose it falls z = -(m g / k_z)(1 - cos(w t)),
 // w = sqrt(k_z / m) = 20; an initial x offset 0.01 oscillates as 0.01 cos(sqrt(k_x / m) t). A
 // torque of 1 N m about z against the rotational stiffness 10 settles (damped) at the exact
-// angle psi with k sin(psi) = T (the bushing's angle is 2 sin(psi / 2), forces.h).
+// angle psi with k sin(psi) = T (the bushing's angle is 2 sin(psi / 2), formulation/forces/bushing.cpp).
 std::string block(const std::string& extra_force, const std::string& damping) {
   return R"(name: block
 gravity: [0, 0, -9.81]
