@@ -298,7 +298,9 @@ TEST(Loads, JointFrictionSpinsAWheelDownToRest) {
       const double exact = slip * std::asinh(std::exp(log_y));
       worst_rate = std::max(worst_rate, std::fabs(rate[k] - exact));
       lowest = std::min(lowest, rate[k]);
-      if (k > 0) EXPECT_LE(rate[k], rate[k - 1] + 1e-9) << t[k];  // never speeds up
+      if (k > 0) {
+        EXPECT_LE(rate[k], rate[k - 1] + 1e-9) << t[k];  // never speeds up
+      }
       EXPECT_NEAR(torque[k], -friction * std::tanh(rate[k] / slip), 1e-12) << t[k];
       if (t[k] <= 4.5)  // w >= 1 rad/s = 20 w_s: Coulomb's constant deceleration
         worst_angle = std::max(worst_angle, std::fabs(angle[k] - (w0 * t[k] - friction * t[k] * t[k] / (2 * inertia))));
