@@ -52,9 +52,6 @@ class GglDae : public MultibodyDae {
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
   std::string component_name(int i) const override;
 
-  // Positions and velocities projected onto the constraints, v' and lambda from the
-  // accelerations, mu = 0; y' = [v, v', 0, 0].
-  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) override;
 
   bool velocities_error_tested() const override { return v_in_test_; }
 
