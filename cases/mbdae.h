@@ -76,6 +76,10 @@ struct Result {
   std::vector<std::vector<double>> data;
   nlohmann::ordered_json summary;  // the content of summary.json (statistics, coordinates, status)
   std::vector<double> q;           // final positions (7 per body)
+  // The model as the run left it (an equilibrium that solves force parameters replaces the
+  // System with one holding their values; a built System is never changed), for what draws or
+  // evaluates the final configuration (the animation of a static run).
+  std::shared_ptr<const System> system;
 
   bool ok() const { return status == "ok"; }
   size_t rows() const { return data.empty() ? 0 : data[0].size(); }

@@ -41,17 +41,29 @@ void velocity_constraint_values(const System& sys, const std::vector<int>& off, 
   }
 }
 
+void velocity_constraint_values(const System& sys, const std::vector<int>& off,
+                                const std::vector<Row14>& cached, const double* v, double t, double* out) {
+  double pt[3], ptt[3];
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const Row14* rows = cached.data() + 3 * k;
+    constraint_time_derivatives(c, t, pt, ptt);
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[r].dot(vl) + pt[r];
+  }
+}
+
 void stabilized_acceleration_constraints(const System& sys, const std::vector<int>& off,
-                                         const double* q, const double* v, const double* a,
-                                         double t, double alpha, double beta, double* out) {
-  Row14 rows[3];
+                                         const std::vector<Row14>& cached, const double* q,
+                                         const double* v, const double* a, double t, double alpha,
+                                         double beta, double* out) {
   double phi[3], pt[3], ptt[3], gamma[3];
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
+    const Row14* rows = cached.data() + 3 * k;
     const LocalState s = gather(q, c.bi, c.bj);
     const Vec14 vl = gather_local(v, c.bi, c.bj), al = gather_local(a, c.bi, c.bj);
     constraint_value(c, s, t, phi);
-    constraint_jacobian(c, s, rows);
     constraint_time_derivatives(c, t, pt, ptt);
     constraint_gamma(c, s, gather(v, c.bi, c.bj), ptt, gamma);
     for (int r = 0; r < c.rows(); ++r) {

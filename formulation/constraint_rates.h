@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/sparse_assembler.h"
+#include "formulation/body_point.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -22,11 +23,16 @@ namespace mbdae {
 // Phi_q v + Phi_t (the velocity-level constraints).
 void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,
                                 const double* q, const double* v, double t, double* out);
-// Baumgarte-stabilized acceleration-level constraints, in one pass over the constraints:
+// The same with Phi_q from constraint_jacobian_rows() (mechanics.h) at the q of the residual.
+void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,
+                                const std::vector<Row14>& rows, const double* v, double t, double* out);
+// Baumgarte-stabilized acceleration-level constraints, in one pass over the constraints, Phi_q
+// from constraint_jacobian_rows() at q:
 //   out = Phi_q a - gamma(q, v, t) + 2 alpha (Phi_q v + Phi_t) + beta^2 Phi(q, t).
 void stabilized_acceleration_constraints(const System& sys, const std::vector<int>& offsets,
-                                         const double* q, const double* v, const double* a,
-                                         double t, double alpha, double beta, double* out);
+                                         const std::vector<Row14>& rows, const double* q,
+                                         const double* v, const double* a, double t, double alpha,
+                                         double beta, double* out);
 
 // --- Sparse assembly (the same add() sequence whatever the values) -------------------------
 // Row i of  s1 (H_i w1)^T + s2 (H_i w2)^T  at (row0 + i, col0 + global column); w2 may be null

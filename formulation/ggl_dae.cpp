@@ -19,12 +19,12 @@ int GglDae::residual(double t_in, const double* y, const double* yp, double* r) 
   const double* mu = y + 2 * nq_ + nc_;
   // F1 = q' - v + Phi_q^T mu,  F2 = M v' + Phi_q^T lambda - Q
   kinematic_and_momentum_residual(t, y, yp, r, work_.data());
-  add_constraint_forces(sys_, offsets_, q, mu, r);
+  add_constraint_forces(sys_, offsets_, constraint_rows(), mu, r);
   // F3 = s Phi,  F4 = s (Phi_q v + Phi_t)
   double* f3 = r + 2 * nq_;
   double* f4 = f3 + nc_;
   constraint_values(sys_, offsets_, q, t, f3);
-  velocity_constraint_values(sys_, offsets_, q, v, t, f4);
+  velocity_constraint_values(sys_, offsets_, constraint_rows(), v, t, f4);
   for (int i = 0; i < 2 * nc_; ++i) f3[i] *= scale_;
   return finite_or_retry(r, size());
 }
@@ -73,13 +73,5 @@ std::string GglDae::component_name(int i) const {
   return "velocity-constraint multiplier (mu) of " + constraint_label(i - 2 * nq_ - nc_);
 }
 
-void GglDae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
-  double* q = y.data();
-  double* v = y.data() + nq_;
-  std::fill(yp.begin(), yp.end(), 0.0);
-  consistent_state(t, q, v, yp.data() + nq_, y.data() + 2 * nq_);
-  std::copy(v, v + nq_, yp.begin());
-  std::fill(y.begin() + 2 * nq_ + nc_, y.end(), 0.0);  // mu
-}
 
 }  // namespace mbdae

@@ -15,12 +15,9 @@
 // IVPs in DAEs, 3.2: BDF converges with order k for all components of a Hessenberg index-2
 // system, and only the index-2 variables need to be left out of the error estimate).
 // lambda and mu are left out (IDASetSuppressAlg). Tolerances per unit of the run's span (issue
-// 21: the local errors of the steps add up to the tolerance over the run). Measured: with v in the test, the phase of
-// the solution is error-controlled; without, it is not, as at index 3 (compound pendulum, 5
-// periods, rtol 1e-9: period error 1e-9 with v tested, 2.6e-7 without, 1e-6 at index 3, for
-// 40 % more steps; five-point suspension dynamics I at rtol 1e-8: wheel_z within 6e-9 of an
-// index-3 run at rtol 1e-13 with v tested, 4.7e-8 without, 4e-8 at index 3, for 1.8x the
-// steps of either).
+// 21: the local errors of the steps add up to the tolerance over the run). With v in the test
+// the phase of the solution is error-controlled (measured: docs/formulation.md, "The index-2
+// GGL formulation").
 //
 // The constraint rows are scaled by s (constraint_scale) for the conditioning of the Newton
 // matrix; the solution does not depend on it.
@@ -52,9 +49,6 @@ class GglDae : public MultibodyDae {
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
   std::string component_name(int i) const override;
 
-  // Positions and velocities projected onto the constraints, v' and lambda from the
-  // accelerations, mu = 0; y' = [v, v', 0, 0].
-  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) override;
 
   bool velocities_error_tested() const override { return v_in_test_; }
 

@@ -18,7 +18,7 @@ int Index1Dae::residual(double t_in, const double* y, const double* yp, double* 
   const double t = input_time(t_in);
   kinematic_and_momentum_residual(t, y, yp, r, work_.data());
   double* f3 = r + 2 * nq_;
-  stabilized_acceleration_constraints(sys_, offsets_, y, y + nq_, yp + nq_, t, bg_.alpha, bg_.beta, f3);
+  stabilized_acceleration_constraints(sys_, offsets_, constraint_rows(), y, y + nq_, yp + nq_, t, bg_.alpha, bg_.beta, f3);
   // Penalty (when set): F3 = s (stabilized acceleration constraints - lambda / p).
   const double* lambda = y + 2 * nq_;
   for (int i = 0; i < nc_; ++i) f3[i] = scale_ * (f3[i] - inverse_penalty_ * lambda[i]);
@@ -59,12 +59,5 @@ void Index1Dae::error_weights(double h, const double* y, double rtol, double ato
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 
-void Index1Dae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
-  double* q = y.data();
-  double* v = y.data() + nq_;
-  std::fill(yp.begin(), yp.end(), 0.0);
-  consistent_state(t, q, v, yp.data() + nq_, y.data() + 2 * nq_);
-  std::copy(v, v + nq_, yp.begin());
-}
 
 }  // namespace mbdae

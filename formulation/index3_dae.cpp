@@ -57,12 +57,5 @@ void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* 
   for (int i = 0; i < nq_; ++i) w[i] = std::fmin(w[i] * f, std::fmax(w[i], i % 7 < 3 ? w_length : w_rotation));
 }
 
-void Index3Dae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
-  double* q = y.data();
-  double* v = y.data() + nq_;
-  std::fill(yp.begin(), yp.end(), 0.0);
-  consistent_state(t, q, v, yp.data() + nq_, y.data() + 2 * nq_);
-  std::copy(v, v + nq_, yp.begin());
-}
 
 }  // namespace mbdae

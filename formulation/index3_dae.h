@@ -43,9 +43,6 @@ class Index3Dae : public MultibodyDae {
   // rtol|v| + atol/h and rtol|lambda| + m_ref atol/h^2.
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
 
-  // Consistent initial values from the q and v in y: positions and velocities projected onto
-  // the constraints, accelerations and multipliers solved; y' = [v, v', 0].
-  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) override;
   bool velocities_error_tested() const override { return false; }
   // Output velocities from the interpolant of v (through the steps' velocities, one degree
   // higher than the derivative of the positions' interpolant, and measured more accurate:

@@ -99,20 +99,41 @@ void constraint_rates(const System& sys, const std::vector<int>& off, const doub
   }
 }
 
+namespace {
+// out += J^T lambda for constraint c's rows (global columns of its two bodies).
+void add_rows_transposed(const Constraint& c, const Row14* rows, const double* lambda, double* out) {
+  for (int r = 0; r < c.rows(); ++r) {
+    const double lam = lambda[r];
+    for (int l = 0; l < 14; ++l) {
+      const int g = global_index(c.bi, c.bj, l);
+      if (g >= 0) out[g] += rows[r](l) * lam;
+    }
+  }
+}
+}  // namespace
+
 void add_constraint_forces(const System& sys, const std::vector<int>& off, const double* q,
                            const double* lambda, double* out) {
   Row14 rows[3];
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
     constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
-    for (int r = 0; r < c.rows(); ++r) {
-      const double lam = lambda[off[k] + r];
-      for (int l = 0; l < 14; ++l) {
-        const int g = global_index(c.bi, c.bj, l);
-        if (g >= 0) out[g] += rows[r](l) * lam;
-      }
-    }
+    add_rows_transposed(c, rows, lambda + off[k], out);
   }
+}
+
+void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Row14>& rows) {
+  rows.resize(3 * sys.constraints.size());  // sized once: no allocation after the first call
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    constraint_jacobian(c, gather(q, c.bi, c.bj), rows.data() + 3 * k);
+  }
+}
+
+void add_constraint_forces(const System& sys, const std::vector<int>& off, const std::vector<Row14>& rows,
+                           const double* lambda, double* out) {
+  for (size_t k = 0; k < sys.constraints.size(); ++k)
+    add_rows_transposed(sys.constraints[k], rows.data() + 3 * k, lambda + off[k], out);
 }
 
 void constraint_jacobian_times(const System& sys, const std::vector<int>& off, const double* q,

@@ -39,6 +39,13 @@ void constraint_rates(const System& sys, const std::vector<int>& offsets, const 
 // out += Phi_q^T lambda.
 void add_constraint_forces(const System& sys, const std::vector<int>& offsets, const double* q,
                            const double* lambda, double* out);
+// The local Jacobian rows of every constraint at q, constraint k's at rows[3 k ..] (rows holds
+// 3 per constraint): computed once per residual evaluation (RunState's cache) and shared by the
+// rows that need Phi_q (Phi_q^T lambda, GGL's Phi_q^T mu, Phi_q v).
+void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Row14>& rows);
+// out += Phi_q^T lambda, Phi_q from constraint_jacobian_rows().
+void add_constraint_forces(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
+                           const double* lambda, double* out);
 // out = Phi_q v.
 void constraint_jacobian_times(const System& sys, const std::vector<int>& offsets,
                                const double* q, const double* v, double* out);

@@ -11,9 +11,9 @@ namespace mbdae {
 
 MultibodyDae::MultibodyDae(const System& sys)
     : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()), aug_(sys) {
-  modes = initial_modes(sys, sys.q0.data(), 0.0);
-  turns = initial_turns(sys);
-  aug_.turns = &turns;
+  state_.modes = initial_modes(sys, sys.q0.data(), 0.0);
+  state_.turns = initial_turns(sys);
+  aug_.turns = &state_.turns;
   for (const auto& b : sys.bodies) mass_scale_ = std::fmax(mass_scale_, b.mass);
   for (size_t k = 0; k < sys.forces.size(); ++k)
     if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
@@ -26,6 +26,15 @@ std::string MultibodyDae::constraint_label(int row) const {
   for (size_t c = 0; c < sys_.constraints.size(); ++c)
     if (row < offsets_[c + 1]) return sys_.constraints[c].label;
   return "row " + std::to_string(row);
+}
+
+void MultibodyDae::consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) {
+  double* q = y.data();
+  double* v = y.data() + nq_;
+  std::fill(yp.begin(), yp.end(), 0.0);
+  consistent_state(t, q, v, yp.data() + nq_, y.data() + 2 * nq_);
+  std::copy(v, v + nq_, yp.begin());
+  std::fill(y.begin() + 2 * nq_ + nc_, y.end(), 0.0);  // further unknowns (GGL's mu)
 }
 
 void MultibodyDae::record_pattern() {
@@ -46,16 +55,17 @@ int MultibodyDae::jacobian(double t_in, double cj, const double* y, const double
 }
 
 void MultibodyDae::kinematic_and_momentum_residual(double t, const double* y, const double* yp,
-                                                   double* r, double* force_work) const {
+                                                   double* r, double* force_work) {
   const double* q = y;
   const double* v = y + nq_;
   const double* lambda = y + 2 * nq_;
   for (int i = 0; i < nq_; ++i) r[i] = yp[i] - v[i];
   double* f2 = r + nq_;
   mass_times(sys_, q, yp + nq_, f2);
-  generalized_forces(sys_, modes, q, v, t, force_work, &turns);
+  generalized_forces(sys_, state_.modes, q, v, t, force_work, &state_.turns);
   for (int i = 0; i < nq_; ++i) f2[i] -= force_work[i];
-  add_constraint_forces(sys_, offsets_, q, lambda, f2);
+  constraint_jacobian_rows(sys_, q, state_.cache.constraint_rows);
+  add_constraint_forces(sys_, offsets_, state_.cache.constraint_rows, lambda, f2);
 }
 
 void MultibodyDae::assemble_kinematic_and_momentum(double t, double cj, const double* y,
@@ -71,7 +81,7 @@ void MultibodyDae::assemble_kinematic_and_momentum(double t, double cj, const do
   }
   assemble_mass(sys_, q, cj, rv, cv, a);
   assemble_inertia_derivatives(sys_, q, v, yp + nq_, rv, cq, cv, a);
-  assemble_force_derivatives(sys_, modes, q, v, t, rv, cq, cv, a, &turns);
+  assemble_force_derivatives(sys_, state_.modes, q, v, t, rv, cq, cv, a, &state_.turns);
   assemble_constraint_hessian(sys_, offsets_, q, lambda, rv, cq, a);
 }
 
@@ -157,7 +167,7 @@ void MultibodyDae::switches(double t_in, const double* y, double* g) {
 
 bool MultibodyDae::changes_mode(double, const double*, const int* roots) {
   for (size_t k = 0; k < switch_forces_.size(); ++k)
-    if (roots[k] != 0 && modes[switch_forces_[k]] != (roots[k] > 0)) return true;
+    if (roots[k] != 0 && state_.modes[switch_forces_[k]] != (roots[k] > 0)) return true;
   return false;
 }
 
@@ -165,10 +175,10 @@ void MultibodyDae::restart(double t, double* y, double* yp, const int* roots) {
   for (size_t k = 0; k < switch_forces_.size(); ++k) {
     const int f = switch_forces_[k];
     if (roots) {
-      if (roots[k] != 0) modes[f] = roots[k] > 0;
+      if (roots[k] != 0) state_.modes[f] = roots[k] > 0;
     } else {
       const Force& force = sys_.forces[f];
-      modes[f] = force_switch_value(force, gather(y, force.bi, force.bj), t) > 0;
+      state_.modes[f] = force_switch_value(force, gather(y, force.bi, force.bj), t) > 0;
     }
   }
   std::vector<double> yy(y, y + size()), yyp(yp, yp + size());
@@ -176,7 +186,7 @@ void MultibodyDae::restart(double t, double* y, double* yp, const int* roots) {
   std::copy(yy.begin(), yy.end(), y);
   std::copy(yyp.begin(), yyp.end(), yp);
   set_switch_offsets(t, y);
-  update_turns(sys_, y, y + nq_, t, turns);
+  update_turns(sys_, y, y + nq_, t, state_.turns);
 }
 
 // The state at a root is a converged step onto the root time (core/ida_driver.cpp), which can lie
@@ -190,7 +200,7 @@ void MultibodyDae::set_switch_offsets(double t, const double* y) {
   for (size_t k = 0; k < switch_forces_.size(); ++k) {
     const Force& force = sys_.forces[switch_forces_[k]];
     const double g = force_switch_value(force, gather(y, force.bi, force.bj), t);
-    if ((g > 0) != static_cast<bool>(modes[switch_forces_[k]]) && g != 0) switch_offsets_[k] = g;
+    if ((g > 0) != static_cast<bool>(state_.modes[switch_forces_[k]]) && g != 0) switch_offsets_[k] = g;
   }
 }
 
@@ -208,14 +218,14 @@ double MultibodyDae::initial_step(double, const double* y, const double* yp, dou
 void MultibodyDae::after_step(double t_in, const double* y) {
   const double t = input_time(t_in);
   constraint_values(sys_, offsets_, y, t, stat_work_.data());
-  max_position_violation = std::fmax(max_position_violation, max_abs(stat_work_.data(), nc_));
+  state_.statistics.max_position_violation = std::fmax(state_.statistics.max_position_violation, max_abs(stat_work_.data(), nc_));
   velocity_constraint_values(sys_, offsets_, y, y + nq_, t, stat_work_.data());
-  max_velocity_violation = std::fmax(max_velocity_violation, max_abs(stat_work_.data(), nc_));
+  state_.statistics.max_velocity_violation = std::fmax(state_.statistics.max_velocity_violation, max_abs(stat_work_.data(), nc_));
   for (int b = 0; b < sys_.num_bodies(); ++b) {
     const double n = Eigen::Map<const Vec4>(y + 7 * b + 3).norm();
-    max_norm_drift = std::fmax(max_norm_drift, std::fabs(n - 1.0));
+    state_.statistics.max_norm_drift = std::fmax(state_.statistics.max_norm_drift, std::fabs(n - 1.0));
   }
-  update_turns(sys_, y, y + nq_, t, turns);
+  update_turns(sys_, y, y + nq_, t, state_.turns);
 }
 
 void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, double* lambda) {
@@ -228,8 +238,8 @@ void MultibodyDae::consistent_state(double t, double* q, double* v, double* a, d
                      "initial positions violate the constraints (max " + std::to_string(pr.residual) +
                          "): " + pr.worst);
   if (!aug_.velocities(q, t, v)) throw SolveError("singular", "velocity projection is singular");
-  if (output_accelerations) aug_.prepare_output_accelerations();
-  if (!aug_.accelerations(modes, q, v, t, a, lambda))
+  if (state_.output.accelerations) aug_.prepare_output_accelerations();
+  if (!aug_.accelerations(state_.modes, q, v, t, a, lambda))
     throw SolveError("singular",
                      "the augmented mass matrix is singular at t = " + std::to_string(t) +
                          " (redundant constraints or an unconstrained massless body)");
@@ -251,44 +261,44 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
   constraint_values(sys_, offsets_, q.data(), t, out_phi_.data());
   const double violation = max_abs(out_phi_.data(), nc_);
   // The condition estimate costs a factorization: every tenth sample is enough to see it grow.
-  if (track_condition && (condition_samples_++ % 10) == 0) {
+  if (state_.output.track_condition && (condition_samples_++ % 10) == 0) {
     const double c = aug_.constraint_condition(q.data());
-    if (c > max_condition) {
-      max_condition = c;
-      max_condition_time = t;
+    if (c > state_.statistics.max_condition) {
+      state_.statistics.max_condition = c;
+      state_.statistics.max_condition_time = t;
     }
   }
-  // A solve that fails is reported in output_failure (the run stops there): its numbers are
+  // A solve that fails is reported in state_.output_failure (the run stops there): its numbers are
   // not written as if they were the state. The position projection asks for 1e-14 but is
   // accepted at the rounding level of the coordinates (position_noise).
-  output_failure.clear();
+  state_.output_failure.clear();
   char buf[200];
   bool finite = true;
   for (int i = 0; i < nq_; ++i) finite = finite && std::isfinite(q[i]) && std::isfinite(v[i]);
   if (!finite) {
     std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the interpolated positions are not finite", t_in);
-    output_failure = buf;
+    state_.output_failure = buf;
   }
-  if (project && output_failure.empty()) {
+  if (project && state_.output_failure.empty()) {
     if (violation > 1e-14) {
       const PositionSolveResult r = aug_.positions(q.data(), t, 1e-14, 5);
       if (!(r.residual <= std::fmax(1e-14, position_noise(q.data())))) {
         std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the position constraints did not converge (max |Phi| %.3g after %d iterations)",
                       t_in, r.residual, r.iterations);
-        output_failure = buf;
+        state_.output_failure = buf;
       }
     }
     velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
     double vmax = 1.0;
     for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
-    if (output_failure.empty() && max_abs(out_phi_.data(), nc_) > 1e-14 * vmax && !aug_.velocities(q.data(), t, v.data())) {
+    if (state_.output_failure.empty() && max_abs(out_phi_.data(), nc_) > 1e-14 * vmax && !aug_.velocities(q.data(), t, v.data())) {
       std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the velocity constraints failed (singular constraint Jacobian)", t_in);
-      output_failure = buf;
+      state_.output_failure = buf;
     }
   }
-  if (output_failure.empty() && output_accelerations && !aug_.output_accelerations(modes, q.data(), v.data(), t, a.data(), output_acceleration_tolerance)) {
+  if (state_.output_failure.empty() && state_.output.accelerations && !aug_.output_accelerations(state_.modes, q.data(), v.data(), t, a.data(), state_.output.acceleration_tolerance)) {
     std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the acceleration solve failed (singular augmented matrix)", t_in);
-    output_failure = buf;
+    state_.output_failure = buf;
   }
   return violation;
 }

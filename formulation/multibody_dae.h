@@ -8,9 +8,9 @@
 //
 // A formulation derives from MultibodyDae and provides size(), the residual, assemble() (its
 // Newton matrix by add() calls; record_pattern() at the end of its constructor), the error-test
-// mask and weights, and consistent_initial_values() (which places q, v, a and lambda from
-// consistent_state() into its own y, y'). The first 2 nq components of y must be q and v, the
-// next nc lambda.
+// mask and weights. The first 2 nq components of y must be q and v, the next nc lambda; any
+// further unknowns start at zero (consistent_initial_values()). What changes during a run lives
+// in its RunState (state()), not in the model.
 #pragma once
 
 #include <cmath>
@@ -20,6 +20,7 @@
 #include "core/dae_problem.h"
 #include "core/sparse_assembler.h"
 #include "formulation/augmented_solver.h"
+#include "formulation/run_state.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -67,8 +68,9 @@ class MultibodyDae : public DaeProblem {
     return t < cap ? t : cap;
   }
 
-  // Consistent initial values from the q and v in y (projected onto the constraints).
-  virtual void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp) = 0;
+  // Consistent initial values from the q and v in y: q and v projected onto the constraints,
+  // y' = [v, a, 0...], lambda after v, the unknowns beyond 2 nq + nc (GGL's mu) zero.
+  void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
   // Output state from an interpolated (y, y'): optionally projected onto the constraint
   // manifold (positions and velocities), then the accelerations solved from it. Returns the
   // position violation of the interpolated y. (Same contract as Index3Dae::consistent_output.)
@@ -76,29 +78,16 @@ class MultibodyDae : public DaeProblem {
   // else from the derivative of the positions' interpolant, q' in y'.
   double consistent_output(double t, const double* y, const double* yp, std::vector<double>& q,
                            std::vector<double>& v, std::vector<double>& a, bool project);
-  // Empty, or why the last consistent_output() could not give a consistent state (a projection
-  // or the acceleration solve failed, or y was not finite): its numbers must not be used.
-  std::string output_failure;
   // Whether v is in the local error test (then its interpolant is error-controlled).
   virtual bool velocities_error_tested() const = 0;
   // Whether output velocities come from the interpolant of v (else from q' in y').
   virtual bool output_velocities_from_state() const { return velocities_error_tested(); }
   bool output_needs_derivative() const override { return !output_velocities_from_state(); }
 
-  std::vector<char> modes;            // per force: wheel in contact
-  CoordinateTurns turns;              // whole turns of rotation coordinates (system.h), after each accepted step
-  double max_position_violation = 0;  // max |Phi| over accepted steps (integrator's own solution)
-  double max_velocity_violation = 0;  // max |Phi_q v + Phi_t| over accepted steps
-  // Solve accelerations for output samples (only needed by acceleration sensors).
-  bool output_accelerations = true;
-  // Relative error allowed in the output accelerations' linear solve (run(): min(1e-10, 1e-3
-  // rtol), below the integration error they carry at any rtol; AugmentedSolver::output_accelerations).
-  double output_acceleration_tolerance = 1e-12;
-  double max_norm_drift = 0;          // max | |p| - 1 | over accepted steps
-  // Conditioning of the constraints along the run (computed at output samples when
-  // track_condition is set: one extra factorization every tenth sample).
-  bool track_condition = false;
-  double max_condition = 0.0, max_condition_time = 0.0;
+  // The run state (formulation/run_state.h): modes, turns, output settings, statistics, the
+  // output failure and the per-evaluation cache. The model, system(), never changes.
+  RunState& state() { return state_; }
+  const RunState& state() const { return state_; }
   int nq() const { return nq_; }
   int nc() const { return nc_; }
   const System& system() const { return sys_; }
@@ -116,9 +105,11 @@ class MultibodyDae : public DaeProblem {
   void record_pattern();
   // The rows every formulation shares, at y = [q, v, lambda, ...], y' = [q', v', ...]:
   //   F1 = q' - v  (rows 0..nq),   F2 = M(q) v' + Phi_q^T lambda - Q(q, v, t)  (rows nq..2nq).
-  // `force_work` holds nq values.
+  // `force_work` holds nq values. Computes the constraint Jacobian rows at q into the run
+  // state's cache (constraint_rows()), for the formulation's own rows of the same residual.
   void kinematic_and_momentum_residual(double t, const double* y, const double* yp, double* r,
-                                       double* force_work) const;
+                                       double* force_work);
+  const std::vector<Row14>& constraint_rows() const { return state_.cache.constraint_rows; }
   // Their Newton-matrix blocks: F1's cj I and -I; F2's cj M, d(M v')/dq with the gyroscopic
   // derivatives, -dQ/dq, -dQ/dv and sum_k lambda_k d2Phi_k/dq2. (Phi_q^T in F2's lambda
   // columns is added by the formulation with its constraint rows.)
@@ -141,13 +132,9 @@ class MultibodyDae : public DaeProblem {
   // where v is rounding noise of about 1e-15 m/s. `h` is used before the first Newton matrix.
   double position_atol(const double* y, double atol) const;
   double velocity_atol(double h, const double* y, double atol) const;
-  // Error weights of the positions, w_i = 1 / (rtol |q_i| + aq), the same for every coordinate.
-  // Measured alternative (not used): the Euler parameters against their norm, 1, instead of
-  // their own size. A small component (rod1's e2, about 1e-3) then no longer sets the step
-  // (it set 20622 of the 29476 steps of the poster run at rtol 1e-7, atol 1e-13), and the run
-  // takes 36 % fewer steps at the same tolerances, but the wheel-centre error grows by more,
-  // 20 to 360 times; at equal error the cost is the same (poster, 1e-6 m: 21926 steps against
-  // 22108). The plain relative test keeps the accuracy a tolerance promises.
+  // Error weights of the positions, w_i = 1 / (rtol |q_i| + aq), the same for every coordinate
+  // (the Euler parameters against their own size, not their norm: docs/formulation.md, "Error
+  // control").
   void position_weights(const double* y, double rtol, double aq, double* w) const;
   double newton_cj_ = 0;  // cj of the last Newton matrix (set by jacobian())
 
@@ -184,6 +171,7 @@ class MultibodyDae : public DaeProblem {
   std::vector<double> switch_offsets_;
   void set_switch_offsets(double t, const double* y);
   AugmentedSolver aug_;
+  RunState state_;
   std::vector<double> stat_work_, out_phi_;
   long condition_samples_ = 0;
   SparseAssembler asm_;        // the Newton matrix's pattern and slot table

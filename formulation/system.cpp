@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/errors.h"
+#include "formulation/model_rules.h"
 #include "formulation/system_build.h"
 
 namespace mbdae {
@@ -110,6 +112,12 @@ void update_turns(const System& sys, const double* q, const double* v, double t,
 }
 
 System build_system(const Model& model) {
+  // The model's rules (formulation/model_rules.h), the same the loader reports in full: the
+  // first problem refuses the model, so the stages below meet only valid references.
+  const std::vector<ModelIssue> issues = check_model(model);
+  if (!issues.empty())
+    throw ModelError(issues.front().item.file, issues.front().item.line, issues.front().shown_field(),
+                     issues.front().message);
   System sys;
   sys.name = model.name;
   sys.gravity = model.gravity;

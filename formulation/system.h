@@ -121,7 +121,8 @@ struct System {
   std::vector<double> breakpoints() const;
 };
 
-// Throws ModelError (with the scene location) on an inconsistent model.
+// Throws ModelError (with the scene location) at the first problem check_model() finds
+// (formulation/model_rules.h: the rules the loader reports in full).
 System build_system(const Model& model);
 
 // A constraint holding joint coordinate `k` at `value` (for assembly with independent

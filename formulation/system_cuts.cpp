@@ -18,8 +18,7 @@ struct CutSides {
 
 // The cut frame on one side, in its body's frame: z along `axis`, x along `ref` without its
 // component along the axis; a zero `ref` takes the body axis most perpendicular to `axis`.
-Mat3 cut_frame(const CutSpec& cut, const Vec3& axis, const Vec3& ref, const char* axis_field,
-               const char* ref_field) {
+Mat3 cut_frame(const Vec3& axis, const Vec3& ref) {
   const Vec3 z = axis.normalized();
   Vec3 r = ref;
   if (r.isZero()) {
@@ -28,11 +27,7 @@ Mat3 cut_frame(const CutSpec& cut, const Vec3& axis, const Vec3& ref, const char
       if (std::fabs(z[m]) < std::fabs(z[k]) - 1e-12) k = m;
     r = Vec3::Unit(k);
   }
-  const Vec3 x = r - r.dot(z) * z;
-  if (x.norm() < 1e-6 * r.norm())
-    fail(cut.where, ref_field,
-         "cut '" + cut.name + "': " + ref_field + " is parallel to " + axis_field +
-             "; give a reference direction across the axis");
+  const Vec3 x = r - r.dot(z) * z;  // not along z: check_model's cut_reference_across_axis()
   Mat3 f;
   f.col(0) = x.normalized();
   f.col(2) = z;
@@ -53,8 +48,8 @@ Constraint cut_constraint(Constraint::Type type, const CutSides& s) {
 // The three equations that hold cut frame 1 on cut frame 2.
 template <class Add>
 void add_frame_alignment(const CutSpec& cut, const CutSides& s, Add add) {
-  const Mat3 c1 = s.f1->rotation * cut_frame(cut, cut.axis1, cut.ref1, "axis1", "ref1");
-  const Mat3 c2 = s.f2->rotation * cut_frame(cut, cut.axis2, cut.ref2, "axis2", "ref2");
+  const Mat3 c1 = s.f1->rotation * cut_frame(cut.axis1, cut.ref1);
+  const Mat3 c2 = s.f2->rotation * cut_frame(cut.axis2, cut.ref2);
   Vec4 w[3];
   orientation_rows(euler_parameters_from_rotation(c1), euler_parameters_from_rotation(c2), w);
   for (int k = 0; k < 3; ++k) {
@@ -71,8 +66,6 @@ void add_cut_constraints(const ModelIndex& index, System& sys) {
     const auto p1 = point_of(index, sys, cut.body1, cut.point1, cut.where, "body1");
     const auto p2 = point_of(index, sys, cut.body2, cut.point2, cut.where, "body2");
     const CutSides s{p1.first, p2.first, p1.second, p2.second};
-    if (s.f1->body == s.f2->body)
-      fail(cut.where, "body2", "cut '" + cut.name + "' joins two parts of the same rigid body");
     auto add = [&](Constraint c, const std::string& what) {
       c.owner = Constraint::Owner::kCut;
       c.owner_name = cut.name;

@@ -15,8 +15,7 @@ int third_axis(int a, int b) { return 3 - a - b; }
 
 // The joint coordinates of a chain, appended to sys.coordinates.
 void add_chain_coordinates(const ModelIndex& index, const JointSpec& j, const ChainParts& parts,
-                           const CoordinateFunction& base, bool merged,
-                           std::set<std::string>& coordinate_names, System& sys) {
+                           const CoordinateFunction& base, bool merged, System& sys) {
   int rot_seen = 0;
   for (const auto& e : j.chain) {
     JointCoordinate jc;
@@ -52,8 +51,6 @@ void add_chain_coordinates(const ModelIndex& index, const JointSpec& j, const Ch
       f.child_frame = parts.rotations_first;
     }
     jc.function = f;
-    if (!coordinate_names.insert(jc.name).second)
-      fail(j.where, "coordinates", "coordinate '" + jc.name + "' is used by two joints");
     sys.coordinates.push_back(jc);
   }
 }
@@ -124,14 +121,11 @@ void add_chain_constraints(const JointSpec& j, const ChainParts& parts, const Co
 }  // namespace
 
 void add_joint_constraints(const ModelIndex& index, System& sys) {
-  std::set<std::string> coordinate_names;
   for (const JointSpec* jp : index.tree.order) {
     const JointSpec& j = *jp;
     const BodyFrame& fp = sys.frames[j.parent];
     const BodyFrame& fc = sys.frames[j.child];
     const bool merged = index.tree.host.at(j.child) == index.tree.host.at(j.parent);
-    const std::vector<std::string> problems = chain_problems(j.chain);
-    if (!problems.empty()) fail(j.where, "chain", "joint '" + j.name + "' " + problems.front());
     const ChainParts parts = split_chain(j.chain);
     CoordinateFunction base;
     base.body_parent = fp.body;
@@ -140,7 +134,7 @@ void add_joint_constraints(const ModelIndex& index, System& sys) {
     base.frame_child = fc.rotation;
     base.anchor = fp.local_point(index.anchor_of(j));
     base.origin = fc.local_point(Vec3::Zero());
-    add_chain_coordinates(index, j, parts, base, merged, coordinate_names, sys);
+    add_chain_coordinates(index, j, parts, base, merged, sys);
     if (merged) continue;
     const size_t first = sys.constraints.size();
     add_chain_constraints(j, parts, base, sys);
@@ -163,10 +157,6 @@ void add_joint_constraints(const ModelIndex& index, System& sys) {
       c.label = "lock " + jc.name;
     }
     sys.constraints.push_back(c);
-  }
-  for (const auto& [name, cs] : index.model.coordinates) {
-    if (!coordinate_names.count(name))
-      fail(cs.where, name, "coordinate '" + name + "' belongs to no joint");
   }
 }
 

@@ -1,5 +1,6 @@
-// Stage 1 of build_system(): names and references of bodies and joints, and the joint tree
-// (formulation/joint_tree.h, the rules the scene validation applies too).
+// Stage 1 of build_system(): the bodies and joints by name, and the joint tree
+// (formulation/joint_tree.h). The rules a model must meet are check_model()'s
+// (formulation/model_rules.h); the lookups here fail only on a model that skipped them.
 #include "core/errors.h"
 #include "formulation/system_build.h"
 
@@ -36,33 +37,13 @@ std::pair<const BodyFrame*, Vec3> point_of(const ModelIndex& index, const System
   return {&it->second, it->second.local_point(pt->second)};
 }
 
+// The model passed check_model() (build_system): names are unique, references resolve and
+// every body has a path to ground.
 ModelIndex resolve_tree(const Model& model) {
   ModelIndex index{model, {}, {}, {}};
-  for (const auto& b : model.bodies) {
-    if (b.name == kGround) fail(b.where, "name", "'ground' is reserved");
-    if (!index.bodies.emplace(b.name, &b).second)
-      fail(b.where, "name", "body '" + b.name + "' is defined twice");
-  }
-  for (const auto& j : model.joints) {
-    if (j.parent != kGround && !index.bodies.count(j.parent))
-      fail(j.where, "parent", "joint '" + j.name + "': no body named '" + j.parent + "'");
-    if (!index.bodies.count(j.child))
-      fail(j.where, "child", "joint '" + j.name + "': no body named '" + j.child + "'");
-    if (!index.joint_of_child.emplace(j.child, &j).second)
-      fail(j.where, "child", "body '" + j.child + "' is the child of two tree joints; make one a cut");
-    for (const auto& e : j.chain)
-      if (!model.coordinates.count(e.coordinate))
-        fail(j.where, "coordinates", "joint '" + j.name + "': coordinate '" + e.coordinate + "' has no entry");
-  }
+  for (const auto& b : model.bodies) index.bodies.emplace(b.name, &b);
+  for (const auto& j : model.joints) index.joint_of_child.emplace(j.child, &j);
   index.tree = resolve_joint_tree(model.joints, index.joint_of_child, model.coordinates);
-  for (const auto& b : model.bodies)
-    if (!index.tree.placed.count(b.name)) {
-      auto it = index.joint_of_child.find(b.name);
-      if (it != index.joint_of_child.end())
-        fail(it->second->where, "parent",
-             "body '" + b.name + "' has no path to ground (the joint tree has a loop)");
-      fail(b.where, "name", "body '" + b.name + "' has no joint to a parent (no path to ground)");
-    }
   return index;
 }
 

@@ -426,18 +426,10 @@ void AnimationSink::write_frame(double t, const double* q, const double* v, cons
 
 // A scene without integration (assembly, equilibrium) is drawn once, at its final configuration.
 void AnimationSink::write_static_frame(const Result& result) {
-  auto system = std::make_unique<System>(build_system(scene_.model));
-  System& sys = *system;
+  // The run's final model (solved force parameters included), else the scene's as built.
+  auto system = std::make_unique<System>(result.system ? *result.system : build_system(scene_.model));
+  const System& sys = *system;
   if (result.q.size() != static_cast<size_t>(sys.nq())) return;
-  const nlohmann::ordered_json steps = result.summary.value("steps", nlohmann::ordered_json::array());
-  for (const auto& step : steps) {
-    const nlohmann::ordered_json parameters = step.value("parameters", nlohmann::ordered_json::object());
-    for (const auto& [key, value] : parameters.items()) {
-      const size_t dot = key.rfind('.');
-      const int f = sys.force_index(key.substr(0, dot));
-      if (double* p = f >= 0 ? force_parameter(sys.forces[f], key.substr(dot + 1)) : nullptr) *p = value;
-    }
-  }
   const double t = scene_.steps.empty() ? 0.0 : scene_.steps.back().t0;
   start(std::move(system), t, t);
   const std::vector<double> v(sys.nq(), 0.0);

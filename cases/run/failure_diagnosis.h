@@ -13,10 +13,8 @@
 
 namespace mbdae {
 
-// The Jacobian counts as singular where the row-normalized Phi_q has s_min / s_max below this.
-// Measured on the suspension's kinematic drive: 0.048 at the design angle, 1.9e-3 at 0.004 rad
-// short of the end of rod 2's travel, 2e-5 where the drive past the travel fails (1.8e-6 rad
-// short of it; s_min goes like the square root of the distance to the fold).
+// The Jacobian counts as singular where the row-normalized Phi_q has s_min / s_max below this
+// (the suspension's values along its kinematic drive: docs/extreme-cases.md).
 constexpr double kSingularRatio = 1e-4;
 // The message names the joints, cuts and drives with an equation of at least this weight.
 constexpr double kNamedWeight = 0.5;

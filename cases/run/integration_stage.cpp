@@ -81,18 +81,18 @@ std::unique_ptr<MultibodyDae> make_dae(const System& sys, const Formulation& f, 
 bool start(RunContext& c, const AnalysisStep& step, MultibodyDae& dae, std::vector<double>& y,
            std::vector<double>& yp, json& js) {
   const System& sys = *c.system;
-  dae.modes = initial_modes(sys, c.q.data(), step.t0);
+  dae.state().modes = initial_modes(sys, c.q.data(), step.t0);
   if (c.turns) {  // the turns counted by the previous integration step
-    dae.turns = *c.turns;
-    dae.turns.timed = false;
+    dae.state().turns = *c.turns;
+    dae.state().turns.timed = false;
   }
-  dae.track_condition = step.type == AnalysisStep::Type::kKinematics;  // closeness to a singular configuration
-  dae.output_accelerations = false;  // output samples solve for accelerations only if a sensor reports one
+  dae.state().output.track_condition = step.type == AnalysisStep::Type::kKinematics;  // closeness to a singular configuration
+  dae.state().output.accelerations = false;  // output samples solve for accelerations only if a sensor reports one
   for (const auto& s : sys.sensors)
-    if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
+    if (s.type == SensorSpec::Type::kAcceleration) dae.state().output.accelerations = true;
   // index3 runs far more accurate than rtol (error per unit step): 1e-3 rtol alone would let the
   // output solve's error show at loose rtol (docs/performance.md).
-  dae.output_acceleration_tolerance = std::fmin(1e-10, 1e-3 * (c.options.rtol > 0 ? c.options.rtol : step.rtol));
+  dae.state().output.acceleration_tolerance = std::fmin(1e-10, 1e-3 * (c.options.rtol > 0 ? c.options.rtol : step.rtol));
   y.assign(dae.size(), 0.0);
   yp.assign(dae.size(), 0.0);
   std::copy(c.q.begin(), c.q.end(), y.begin());
@@ -188,18 +188,18 @@ struct Sampler {
     const System& sys = *c.system;
     max_output_violation =
         std::fmax(max_output_violation, dae.consistent_output(t, y, yp, qo, vo, ao, step.output_projection));
-    if (!dae.output_failure.empty()) return false;  // not a consistent state: not written
+    if (!dae.state().output_failure.empty()) return false;  // not a consistent state: not written
     if (!set_aside(sys, qo.data(), dae.input_time(t))) return false;  // not the mechanism's motion: not written
     // Coordinate sensors count whole turns as the loads do (formulation/system.h, CoordinateTurns).
-    evaluate_sensors(sys, dae.modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(), nullptr,
-                     &dae.turns);
+    evaluate_sensors(sys, dae.state().modes, qo.data(), vo.data(), ao.data(), dae.input_time(t), sensors.data(), nullptr,
+                     &dae.state().turns);
     row[0] = t;
     for (size_t k = 0; k < c.column_sensors.size(); ++k) row[k + 1] = sensors[c.column_sensors[k]];
     if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
       throw non_finite_error("sensor " + c.result.columns[k], row[k], t);  // the driver stops the run
     for (size_t k = 0; k < row.size(); ++k) c.result.data[k].push_back(row[k]);
     if (!c.sinks.empty()) {
-      const Sample sample{t, row.data(), qo.data(), vo.data(), ao.empty() ? nullptr : ao.data(), &dae.modes,
+      const Sample sample{t, row.data(), qo.data(), vo.data(), ao.empty() ? nullptr : ao.data(), &dae.state().modes,
                           dae.input_time(t)};
       try {
         for (Sink* s : c.sinks) s->sample(sample);
@@ -240,14 +240,14 @@ json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler&
   stats["nonlinear_failures"] = st.nonlinear_failures;
   stats["restarts"] = st.restarts;
   stats["cpu_seconds"] = st.cpu_seconds;
-  stats["max_position_violation_steps"] = dae.max_position_violation;
+  stats["max_position_violation_steps"] = dae.state().statistics.max_position_violation;
   stats["max_position_violation_output_before_projection"] = s.max_output_violation;
-  stats["max_euler_norm_drift"] = dae.max_norm_drift;
-  stats["max_velocity_violation_steps"] = dae.max_velocity_violation;
-  if (dae.track_condition) {
+  stats["max_euler_norm_drift"] = dae.state().statistics.max_norm_drift;
+  stats["max_velocity_violation_steps"] = dae.state().statistics.max_velocity_violation;
+  if (dae.state().output.track_condition) {
     // Closeness to a singular configuration along a kinematic run.
-    stats["max_constraint_condition"] = dae.max_condition;
-    stats["max_constraint_condition_time"] = dae.max_condition_time;
+    stats["max_constraint_condition"] = dae.state().statistics.max_condition;
+    stats["max_constraint_condition_time"] = dae.state().statistics.max_condition_time;
   }
   stats["output_rows"] = rows;
   return stats;
@@ -260,7 +260,7 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
   if (st.status == "integration_failed") {
     const System& sys = *c.system;
     const FailureDiagnosis d = diagnose_integration_failure(
-        sys, dae.modes, c.column_sensors, c.q.data(), y.data() + sys.nq(), st.t_reached, dae.input_time(st.t_reached),
+        sys, dae.state().modes, c.column_sensors, c.q.data(), y.data() + sys.nq(), st.t_reached, dae.input_time(st.t_reached),
         dae.augmented().constraint_condition(c.q.data()), st.message, c.all_equations.get());
     for (const auto& [key, value] : d.details.items()) js[key] = value;
     if (d.singular || d.degraded_choice) {
@@ -304,7 +304,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
   std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
-  c.turns = dae->turns;
+  c.turns = dae->state().turns;
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
   js["event_times"] = st.event_times;
   js["breakpoint_times"] = st.breakpoint_times;
@@ -318,9 +318,9 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
     std::printf("%s: %ld steps, %ld residual evaluations, %ld KLU factorizations, %zu events, "
                 "cpu %.3f s, max constraint violation %.2e\n",
                 js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
-                st.event_times.size(), st.cpu_seconds, dae->max_position_violation);
-  if (!dae->output_failure.empty()) {
-    fail(c, "output_solve_failed", dae->output_failure, js);
+                st.event_times.size(), st.cpu_seconds, dae->state().statistics.max_position_violation);
+  if (!dae->state().output_failure.empty()) {
+    fail(c, "output_solve_failed", dae->state().output_failure, js);
     return false;
   }
   if (watch.degraded) {

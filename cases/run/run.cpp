@@ -162,6 +162,7 @@ void fail(RunContext& c, const std::string& status, const std::string& message, 
   c.result.message = message;
   c.result.exit_code = 3;
   c.result.q = c.q;
+  c.result.system = c.system;
   if (c.options.report_failures)  // also under --quiet: a failure is always said
     std::fprintf(stderr, "mbdae: %s\n", message.c_str());
 }
@@ -248,6 +249,7 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
     result.status = "ok";
     result.q = c.q;
   }
+  result.system = c.system;
   for (Sink* s : sinks) {
     try {
       s->end(result);

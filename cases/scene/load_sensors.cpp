@@ -56,6 +56,13 @@ void Loader::sensor(const YAML::Node& n, Model& m) {
     return;
   }
   s.type = it->second;
+  sensor_fields(n, type, general, s);
+  m.sensors.push_back(s);
+}
+
+// The fields of sensor `s` of the given (known) type.
+void Loader::sensor_fields(const YAML::Node& n, const std::string& type, const Fields& general, SensorSpec& s) {
+  using T = SensorSpec::Type;
   const std::string what = "a " + type + " sensor";
   switch (s.type) {
     case T::kPosition: case T::kVelocity: case T::kAcceleration:
@@ -106,7 +113,6 @@ void Loader::sensor(const YAML::Node& n, Model& m) {
       applies(n, what, general, {"name", "type"});
       break;
   }
-  m.sensors.push_back(s);
 }
 
 }  // namespace mbdae::scene_load

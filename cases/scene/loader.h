@@ -148,6 +148,8 @@ struct Loader {
 
   void sensor(const YAML::Node& n, Model& m);
 
+  void sensor_fields(const YAML::Node& n, const std::string& type, const Fields& general, SensorSpec& s);
+
   // `initial_velocities` of a dynamics step: coordinate names to rates.
   void initial_velocities(const YAML::Node& n, const std::string& type, AnalysisStep& s);
 

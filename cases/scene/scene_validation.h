@@ -1,10 +1,6 @@
-// Semantic checks of a loaded scene, run by load_scene_text() before it returns: references
-// between bodies, points, joints, coordinates, cuts, forces, sensors, expressions, output
-// columns and analysis steps, and the joint tree (loops, bodies without a path to ground,
-// bodies welded together by a cut). Every problem is reported, each with its file, line and
-// field; build_system() repeats the essential checks as a second line of defence but stops at
-// the first. The chain and tree rules (which chains are refused, the tree order, which joints
-// merge bodies) are build_system's own, from formulation/joint_tree.h.
+// Semantic checks of a loaded scene, run by load_scene_text() before it returns: the model's
+// rules (formulation/model_rules.h, the same build_system applies) and the scene's own (output
+// columns and analysis steps). Every problem is reported, each with its file, line and field.
 #pragma once
 
 #include <map>
@@ -13,6 +9,7 @@
 #include <vector>
 
 #include "cases/scene/scene.h"
+#include "formulation/model_rules.h"  // did_you_mean
 
 namespace mbdae {
 
@@ -40,8 +37,6 @@ class FieldLines {
   std::map<std::tuple<std::string, int, std::string>, int> lines_;
 };
 
-// "; did you mean 'x'?" if one of `candidates` is within a small edit distance of `name`.
-std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates);
 
 // Appends the problems of `scene` to `issues`. Items the loader could not read at all are
 // absent from the scene; references to them are reported as unknown names.

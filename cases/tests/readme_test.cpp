@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -67,6 +68,20 @@ TEST(Readme, InstallCommandUsesSudoWhereThereIsOne) {
   write_script(dir / "bin" / "sudo", "echo sudo >> " + (dir / "log").string() + "\nexec \"$@\"\n");
   EXPECT_EQ(run_with_path(command, dir / "bin"), 0) << command;
   EXPECT_EQ(read(dir / "log"), "sudo\napt-get update\nsudo\napt-get install\n");
+}
+
+// docs/errors.md quotes what `mbdae` without arguments prints (the usage text), word for word.
+TEST(Readme, ErrorsPageQuotesTheUsageText) {
+  const fs::path out = fs::temp_directory_path() / ("mbdae_usage_" + std::to_string(::getpid()) + ".txt");
+  const int status = std::system((std::string(MBDAE_EXE) + " 2> " + out.string()).c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string usage = read(out);
+  fs::remove(out);
+  ASSERT_NE(usage.find("usage: mbdae run"), std::string::npos) << usage;
+  const std::string page = read(fs::path(MBDAE_SOURCE_DIR) / "docs" / "errors.md");
+  EXPECT_NE(page.find("$ mbdae\n" + usage), std::string::npos)
+      << "docs/errors.md does not quote the usage text as printed:\n" << usage;
 }
 
 }  // namespace

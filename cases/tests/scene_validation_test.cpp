@@ -599,6 +599,31 @@ TEST(SceneValidation, CutWithinOneRigidBody) {
   expect_one(t, line_of(t, "{name: c,"), "body2", "joins two parts of the same rigid body");
 }
 
+// A weld cut's reference direction along its axis leaves the cut frame undefined. This rule
+// was the build's alone (`mbdae check` passed the scene, the run refused it); now the model
+// rules (formulation/model_rules.h) decide for both.
+TEST(SceneValidation, WeldCutReferenceAlongItsAxis) {
+  const std::string t = with("forces:", "cuts:\n  - {name: c, type: weld, body1: ground, body2: arm, point2: tip, "
+                                        "axis1: [0, 0, 1], ref1: [0, 0, 2], ref2: [1, 0, 0]}\nforces:");
+  expect_one(t, line_of(t, "{name: c,"), "ref1", "cut 'c': ref1 is parallel to axis1");
+}
+
+// build_system applies the same rules to a model made in code (no scene file, no loader):
+// its first problem, with the item's location and field.
+TEST(SceneValidation, BuildRefusesAModelByTheSameRules) {
+  Scene s = load_scene_text(kValid, kFile);
+  s.model.sensors[0].target = "thetta";
+  s.model.sensors[0].where = {"made-in-code", 42};
+  try {
+    build_system(s.model);
+    ADD_FAILURE() << "build_system accepted a sensor of an unknown coordinate";
+  } catch (const ModelError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("made-in-code:42: field 'coordinate': ", 0), 0u) << m;
+    EXPECT_NE(m.find("no joint coordinate named 'thetta'; did you mean 'theta'?"), std::string::npos) << m;
+  }
+}
+
 TEST(SceneValidation, WheelContactOnGround) {
   const std::string t = with("stiffness: 10, free_length: 0.5}",
                              "stiffness: 10, free_length: 0.5}\n"

@@ -70,7 +70,7 @@ TEST(Formulations, GglNewtonMatrixIsExact) {
   testing::dae_vectors(st, n, true, y, yp);
   const double cj = 37.0, t = 0.3;
   // Wheel in contact (its force derivatives in the matrix).
-  for (auto& m : dae.modes) m = 1;
+  for (auto& m : dae.state().modes) m = 1;
   const Eigen::MatrixXd an = analytic_matrix(dae, t, cj, y, yp), fd = fd_matrix(dae, t, cj, y, yp);
   const double worst = compare(dae, an, fd, 1e-6, "GGL");
   std::printf("  GGL Newton matrix (%d x %d, %d non-zeros): worst relative error %.2e\n", n, n,
@@ -92,8 +92,8 @@ TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
   std::vector<double> y, yp;
   testing::dae_vectors(st, n, false, y, yp);
   const double cj = 37.0, t = 0.3;
-  for (auto& m : dae.modes) m = 1;
-  for (auto& m : exact.modes) m = 1;
+  for (auto& m : dae.state().modes) m = 1;
+  for (auto& m : exact.state().modes) m = 1;
   const Eigen::MatrixXd an = analytic_matrix(dae, t, cj, y, yp), fd = fd_matrix(dae, t, cj, y, yp);
 
   // The omitted block, -s d(gamma)/dq (F3 rows, q columns), by differences of gamma alone.
@@ -146,8 +146,8 @@ TEST(Formulations, PenaltyResidualAndNewtonMatrix) {
   std::vector<double> y, yp;
   testing::dae_vectors(st, n, false, y, yp);
   const double cj = 37.0, t = 0.3;
-  for (auto& m : pen.modes) m = 1;
-  for (auto& m : plain.modes) m = 1;
+  for (auto& m : pen.state().modes) m = 1;
+  for (auto& m : plain.state().modes) m = 1;
   std::vector<double> rp(n), rn(n);
   pen.residual(t, y.data(), yp.data(), rp.data());
   plain.residual(t, y.data(), yp.data(), rn.data());
@@ -175,14 +175,14 @@ struct Recording : Dae {
   double t_end = 1;
   double phi[3] = {0, 0, 0}, phi_dot[3] = {0, 0, 0};
   void after_step(double t, const double* y) override {
-    const double p = this->max_position_violation, v = this->max_velocity_violation;
-    this->max_position_violation = this->max_velocity_violation = 0;
+    const double p = this->state().statistics.max_position_violation, v = this->state().statistics.max_velocity_violation;
+    this->state().statistics.max_position_violation = this->state().statistics.max_velocity_violation = 0;
     Dae::after_step(t, y);
     const int k = std::min(2, static_cast<int>(3 * t / t_end));
-    phi[k] = std::max(phi[k], this->max_position_violation);
-    phi_dot[k] = std::max(phi_dot[k], this->max_velocity_violation);
-    this->max_position_violation = std::max(p, this->max_position_violation);
-    this->max_velocity_violation = std::max(v, this->max_velocity_violation);
+    phi[k] = std::max(phi[k], this->state().statistics.max_position_violation);
+    phi_dot[k] = std::max(phi_dot[k], this->state().statistics.max_velocity_violation);
+    this->state().statistics.max_position_violation = std::max(p, this->state().statistics.max_position_violation);
+    this->state().statistics.max_velocity_violation = std::max(v, this->state().statistics.max_velocity_violation);
   }
 };
 
@@ -276,9 +276,9 @@ TEST(Formulations, ConstraintDrift) {
   ASSERT_TRUE(rg.stats.ok) << rg.stats.message;
   std::printf("  GGL over %.0f s at rtol %.0e: max |Phi| %.2e (tolerance %.1e), max |Phi'| %.2e, "
               "max | |p| - 1 | %.2e\n",
-              o.t1, o.rtol, rg.max_position_violation, tol, ggl.max_velocity_violation, rg.max_norm_drift);
+              o.t1, o.rtol, rg.max_position_violation, tol, ggl.state().statistics.max_velocity_violation, rg.max_norm_drift);
   EXPECT_LT(rg.max_position_violation, 2 * tol);
-  EXPECT_LT(ggl.max_velocity_violation, 10 * tol);
+  EXPECT_LT(ggl.state().statistics.max_velocity_violation, 10 * tol);
 
   // Index 1: the constraints are integrated, not enforced: Phi and Phi' are driven by each
   // step's local error. With Baumgarte (default alpha = beta = 20/s) they settle at about the

@@ -25,7 +25,7 @@ RunResult integrate_model(Dae& dae, const IdaOptions& o) {
   RunResult run;
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
-  dae.modes = initial_modes(sys, y.data(), o.t0);
+  dae.state().modes = initial_modes(sys, y.data(), o.t0);
   dae.consistent_initial_values(o.t0, y, yp);
   std::vector<double> q, v, a;
   run.stats = integrate(dae, o, y, yp, [&](double t, const double* yy, const double* yyp) {
@@ -35,8 +35,8 @@ RunResult integrate_model(Dae& dae, const IdaOptions& o) {
     run.rate.push_back(coordinate_rate(sys, 0, q.data(), v.data()));
     return true;
   });
-  run.max_position_violation = dae.max_position_violation;
-  run.max_norm_drift = dae.max_norm_drift;
+  run.max_position_violation = dae.state().statistics.max_position_violation;
+  run.max_norm_drift = dae.state().statistics.max_norm_drift;
   return run;
 }
 

@@ -17,7 +17,7 @@ struct Pendulum {
   Index3Dae dae{sys, 1.0};
   std::vector<double> y, yp, q, v, a;
   Pendulum() {
-    dae.modes.assign(sys.forces.size(), 0);
+    dae.state().modes.assign(sys.forces.size(), 0);
     y.assign(dae.size(), 0.0);
     yp.assign(dae.size(), 0.0);
     std::copy(sys.q0.begin(), sys.q0.end(), y.begin());
@@ -28,7 +28,7 @@ struct Pendulum {
 TEST(OutputState, ConsistentSampleIsNotReported) {
   Pendulum p;
   p.dae.consistent_output(0.0, p.y.data(), p.yp.data(), p.q, p.v, p.a, true);
-  EXPECT_TRUE(p.dae.output_failure.empty()) << p.dae.output_failure;
+  EXPECT_TRUE(p.dae.state().output_failure.empty()) << p.dae.state().output_failure;
   for (double x : p.a) EXPECT_TRUE(std::isfinite(x));
 }
 
@@ -38,15 +38,15 @@ TEST(OutputState, ProjectionThatDoesNotConvergeIsReported) {
   Pendulum p;
   for (int k = 3; k < 7; ++k) p.y[k] = 0.0;
   p.dae.consistent_output(0.0, p.y.data(), p.yp.data(), p.q, p.v, p.a, true);
-  EXPECT_NE(p.dae.output_failure.find("projection onto the position constraints did not converge"), std::string::npos)
-      << "reported: '" << p.dae.output_failure << "'";
+  EXPECT_NE(p.dae.state().output_failure.find("projection onto the position constraints did not converge"), std::string::npos)
+      << "reported: '" << p.dae.state().output_failure << "'";
 }
 
 TEST(OutputState, NonFiniteStateIsReported) {
   Pendulum p;
   p.y[0] = NAN;
   p.dae.consistent_output(0.0, p.y.data(), p.yp.data(), p.q, p.v, p.a, false);
-  EXPECT_NE(p.dae.output_failure.find("not finite"), std::string::npos) << "reported: '" << p.dae.output_failure << "'";
+  EXPECT_NE(p.dae.state().output_failure.find("not finite"), std::string::npos) << "reported: '" << p.dae.state().output_failure << "'";
 }
 
 

@@ -120,7 +120,7 @@ Trace integrate_against(const Model& m, double k, double t1, double rtol, F exac
   std::vector<double> q, v, a, s(sys.sensors.size());
   tr.stats = integrate(dae, o, y, yp, [&](double t, const double* yy, const double* yyp) {
     dae.consistent_output(t, yy, yyp, q, v, a, true);
-    evaluate_sensors(sys, dae.modes, q.data(), v.data(), nullptr, t, s.data(), nullptr, &dae.turns);
+    evaluate_sensors(sys, dae.state().modes, q.data(), v.data(), nullptr, t, s.data(), nullptr, &dae.state().turns);
     tr.worst = std::fmax(tr.worst, std::fabs(s[1] - exact(t)));
     tr.worst_torque = std::fmax(tr.worst_torque, std::fabs(s[0] + k * exact(t)));
     tr.min_angle = std::fmin(tr.min_angle, s[1]);
@@ -267,7 +267,7 @@ TEST(RotationSensors, FreeSpinningBodyConservesAngularMomentum) {
     std::vector<double> q, v, acc, s(sys.sensors.size());
     const IdaStats st = integrate(run_dae, o, yy0, yyp0, [&](double t, const double* yy, const double* yyp) {
       run_dae.consistent_output(t, yy, yyp, q, v, acc, true);
-      evaluate_sensors(sys, run_dae.modes, q.data(), v.data(), nullptr, t, s.data(), nullptr, &run_dae.turns);
+      evaluate_sensors(sys, run_dae.state().modes, q.data(), v.data(), nullptr, t, s.data(), nullptr, &run_dae.state().turns);
       if (first) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(s[2 * c + 1], omega[c], 1e-9);
         first_omega = s[1];

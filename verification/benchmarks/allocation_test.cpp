@@ -57,7 +57,7 @@ void expect_none_in_the_step_loop(bool reduced_newton) {
   Index3Dae dae(f.sys, 1.0);
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(f.q.begin(), f.q.end(), y.begin());
-  dae.modes = initial_modes(f.sys, y.data(), 0.0);
+  dae.state().modes = initial_modes(f.sys, y.data(), 0.0);
   dae.consistent_initial_values(0.0, y, yp);
   IdaOptions o;
   o.t0 = 0;
@@ -73,7 +73,7 @@ void expect_none_in_the_step_loop(bool reduced_newton) {
   long window_allocations = 0;
   auto output = [&](double t, const double* yy, const double* yyp) {
     dae.consistent_output(t, yy, yyp, q, v, a, false);
-    evaluate_sensors(f.sys, dae.modes, q.data(), v.data(), a.data(), t, sensors.data());
+    evaluate_sensors(f.sys, dae.state().modes, q.data(), v.data(), a.data(), t, sensors.data());
     const bool in_window = (t >= 0.05 && t <= 0.19) || (t >= 1.0 && t <= 1.45);
     if (in_window && at_start < 0) at_start = g_allocations.load();
     if (!in_window && at_start >= 0) {

@@ -29,7 +29,7 @@ struct State {
       : f(std::move(fx)), dae(f.sys, constraint_scale(f.sys)), y(dae.size()), yp(dae.size()), r(dae.size()),
         values(dae.jacobian_pattern().nnz()) {
     std::copy(f.q.begin(), f.q.end(), y.begin());
-    dae.modes = initial_modes(f.sys, y.data(), 0.0);
+    dae.state().modes = initial_modes(f.sys, y.data(), 0.0);
     dae.consistent_initial_values(0.0, y, yp);
     // A moving state: give the suspension some velocity along its degree of freedom.
     for (int i = 0; i < dae.nq(); ++i) y[dae.nq() + i] += 1e-3 * ((i * 7) % 5 - 2);
@@ -82,7 +82,7 @@ void BM_OutputSample(benchmark::State& st) {
   std::vector<double> q, v, a, out(s.f.sys.sensors.size());
   for (auto _ : st) {
     s.dae.consistent_output(0.1, s.y.data(), s.yp.data(), q, v, a, false);
-    evaluate_sensors(s.f.sys, s.dae.modes, q.data(), v.data(), a.data(), 0.1, out.data());
+    evaluate_sensors(s.f.sys, s.dae.state().modes, q.data(), v.data(), a.data(), 0.1, out.data());
     benchmark::DoNotOptimize(out.data());
   }
 }
@@ -93,7 +93,7 @@ void BM_OutputSampleProjected(benchmark::State& st) {
   std::vector<double> q, v, a, out(s.f.sys.sensors.size());
   for (auto _ : st) {
     s.dae.consistent_output(0.1, s.y.data(), s.yp.data(), q, v, a, true);
-    evaluate_sensors(s.f.sys, s.dae.modes, q.data(), v.data(), a.data(), 0.1, out.data());
+    evaluate_sensors(s.f.sys, s.dae.state().modes, q.data(), v.data(), a.data(), 0.1, out.data());
     benchmark::DoNotOptimize(out.data());
   }
 }

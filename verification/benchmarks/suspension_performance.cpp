@@ -104,11 +104,11 @@ Costs kernel_costs(const std::string& scene_file) {
   Index3Dae dae(sys, 1.0);
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0), r(dae.size());
   std::copy(pre.q.begin(), pre.q.end(), y.begin());
-  dae.modes = initial_modes(sys, y.data(), 0.0);
+  dae.state().modes = initial_modes(sys, y.data(), 0.0);
   dae.consistent_initial_values(0.0, y, yp);
-  dae.output_accelerations = false;  // as run(): only for acceleration sensors
+  dae.state().output.accelerations = false;  // as run(): only for acceleration sensors
   for (const auto& s : sys.sensors)
-    if (s.type == SensorSpec::Type::kAcceleration) dae.output_accelerations = true;
+    if (s.type == SensorSpec::Type::kAcceleration) dae.state().output.accelerations = true;
   std::vector<double> values(dae.jacobian_pattern().nnz()), q, v, a, s(sys.sensors.size());
   KluSolver klu;
   klu.analyze(dae.jacobian_pattern());
@@ -136,7 +136,7 @@ Costs kernel_costs(const std::string& scene_file) {
   c.klu = time([&] { klu.factor(values.data()); });
   c.output = time([&] {
     dae.consistent_output(0.0, y.data(), yp.data(), q, v, a, false);
-    evaluate_sensors(sys, dae.modes, q.data(), v.data(), a.data(), 0.0, s.data());
+    evaluate_sensors(sys, dae.state().modes, q.data(), v.data(), a.data(), 0.0, s.data());
   });
   return c;
 }

@@ -265,14 +265,14 @@ Result run_one(int n, Topology topo) {
   // the rate theta' = -1 rad/s of crank 0, the rest from the constraints (timed with the
   // consistent start). Index3Dae's velocity projection then makes them consistent to rounding.
   Index3Dae dae(sys, 1.0 / (1e-3 * 1e-3));  // run()'s automatic scale: mean mass / (1e-3 s)^2
-  dae.modes = initial_modes(sys, q.data(), 0.0);
+  dae.state().modes = initial_modes(sys, q.data(), 0.0);
   res.unknowns = dae.size();
   res.jac_nnz = dae.jacobian_pattern().nnz();
   std::vector<double> y(dae.size(), 0.0), yp(dae.size(), 0.0);
   std::copy(q.begin(), q.end(), y.begin());
   c0 = cpu_now();
   if (fb) solve_initial_velocities(sys, y.data(), 0.0, {{sys.coordinate_index("th0"), rate0}}, y.data() + sys.nq());
-  dae.output_accelerations = false;  // as run(): no acceleration sensor
+  dae.state().output.accelerations = false;  // as run(): no acceleration sensor
   dae.consistent_initial_values(0.0, y, yp);
   res.init_s = cpu_now() - c0;
 
@@ -294,7 +294,7 @@ Result run_one(int n, Topology topo) {
   res.integrate_s = st.cpu_seconds;
   res.residual_s = timed.residual_seconds;
   res.jacobian_s = timed.jacobian_seconds;
-  res.max_violation = dae.max_position_violation;
+  res.max_violation = dae.state().statistics.max_position_violation;
   if (fb) res.theta_end = coordinate_value(sys, sys.coordinate_index("th0"), y.data());
 
   // Reference theta(0.5) of M theta'' = -C cos(theta) (RK4, h = 1e-5).
