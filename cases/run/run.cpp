@@ -8,6 +8,7 @@
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/augmented_solver.h"
+#include "formulation/force_types.h"
 #include "formulation/formulation_registry.h"
 #include "formulation/redundancy.h"
 #include "formulation/sensors.h"
@@ -41,13 +42,8 @@ std::string sensor_unit(const System& sys, const Sensor& s) {
     case T::kCoordinate: return sys.coordinates[s.target].function.rotation ? "rad" : "m";
     case T::kCoordinateRate: return sys.coordinates[s.target].function.rotation ? "rad/s" : "m/s";
     case T::kForceLength:
-    case T::kForceValue: {  // torques and rotational joint springs measure angles and moments
-      const Force& f = sys.forces[s.target];
-      const bool rotational = f.type == ForceSpec::Type::kTorque ||
-                              (f.type == ForceSpec::Type::kJointSpringDamper && f.coordinate.rotation);
-      if (s.type == T::kForceLength) return rotational ? (f.type == ForceSpec::Type::kTorque ? "1" : "rad") : "m";
-      return rotational ? "N m" : "N";
-    }
+    case T::kForceValue:  // the force type's row: angles and moments on rotations
+      return force_sensor_unit(sys.forces[s.target], s.type == T::kForceLength);
     case T::kKineticEnergy:
     case T::kPotentialEnergy: return "J";
     case T::kAngularVelocity: return "rad/s";
