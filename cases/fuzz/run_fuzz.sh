@@ -56,6 +56,8 @@ sources=()
 for lib in mbdae_core mbdae_formulation mbdae_scene; do
   for f in $(library_sources "$lib"); do sources+=("$root/$f"); done
 done
+# The force laws, one file each, which the build takes by glob (MBDAE_FORCE_LAWS).
+for f in "$root"/formulation/forces/*.cpp; do [[ -e "$f" ]] && sources+=("$f"); done
 if [[ ${#sources[@]} -lt 3 ]]; then
   sources=("$root"/core/*.cpp "$root"/formulation/*.cpp "$root/cases/scene/scene_loader.cpp" "$root/cases/scene/scene_validation.cpp")
 fi
