@@ -5,6 +5,7 @@
 
 #include "core/errors.h"
 #include "core/expression.h"
+#include "formulation/cut_types.h"
 #include "formulation/force_types.h"
 #include "formulation/forces.h"
 
@@ -315,7 +316,7 @@ struct ModelRules : ModelNames {
       }
       check_point(c.where, who, "body1", c.body1, "point1", c.point1);
       check_point(c.where, who, "body2", c.body2, "point2", c.point2);
-      if (c.type == CutSpec::Type::kWeld || c.type == CutSpec::Type::kPrismatic) {
+      if (cut_type(c.type).frames) {
         cut_reference_across_axis(c, who, c.axis1, c.ref1, "axis1", "ref1");
         cut_reference_across_axis(c, who, c.axis2, c.ref2, "axis2", "ref2");
       }

@@ -1,11 +1,13 @@
 // The stages of build_system() (formulation/system.cpp), in the order it runs them:
-//   1. resolve_tree          names, references and the joint tree      (system_tree.cpp)
+//   1. resolve_tree          the bodies and joints by name, the joint tree (system_tree.cpp)
 //   2. merge_locked_joints   rigid composites, their inertia, frames, q0 (system_bodies.cpp)
 //   3. add_joint_constraints tree joints -> coordinates and constraints (system_joints.cpp)
-//   4. add_cut_constraints   loop cuts -> constraints                   (system_cuts.cpp)
+//   4. add_cut_constraints   loop cuts -> constraints (cut_types.cpp)    (system_cuts.cpp)
 //   5. add_forces_and_sensors                                           (system_loads.cpp)
-// Each stage reads the model (through the index of stage 1) and appends to the System; each
-// throws ModelError at the first problem. Internal to formulation/.
+// Each stage reads the model (through the index of stage 1) and appends to the System. The
+// model has passed check_model() (formulation/model_rules.h) before stage 1: the stages apply
+// no rules of their own; what fail() remains guards lookups, and the limits of a load's compiled
+// expressions (bodies read, variables), which need the built sensors. Internal to formulation/.
 #pragma once
 
 #include <map>

@@ -32,13 +32,9 @@ void add_load_fields(const ForceSpec& fs, const System& sys, const NameIndex& co
   f.ct = fs.translational_damping;
   f.kr = fs.rotational_stiffness;
   f.cr = fs.rotational_damping;
-  if (fs.type == ForceSpec::Type::kBushing && f.bi == f.bj)
-    fail(fs.where, "body2", "bushing '" + fs.name + "' joins two parts of the same rigid body");
   if (row.attach == ForceAttach::kCoordinate) {
     const int k = find_name(coordinate_of, fs.coordinate);
     if (k < 0) fail(fs.where, "coordinate", "no joint coordinate named '" + fs.coordinate + "'");
-    if (sys.coordinates[k].merged)
-      fail(fs.where, "coordinate", "coordinate '" + fs.coordinate + "' belongs to a locked joint");
     f.coordinate = sys.coordinates[k].function;
     f.coordinate_index = k;
     f.wrap = fs.wrap;
@@ -163,11 +159,6 @@ void add_forces(const ModelIndex& index, System& sys, const NameIndex& coordinat
     f.ground = fs.ground;
     f.radius = fs.radius;
     f.axis = b1->local_vector(fs.axis.normalized());
-    if (fs.type == ForceSpec::Type::kWheelContact && f.bi < 0)
-      fail(fs.where, "body1", "wheel contact on a body merged into ground");
-    if ((fs.type == ForceSpec::Type::kTorque || fs.type == ForceSpec::Type::kPointForce) && f.bi < 0)
-      fail(fs.where, "body", std::string(fs.type == ForceSpec::Type::kTorque ? "torque" : "point force") + " '" +
-                                 fs.name + "' on ground (or a body fixed to it) does nothing");
     add_load_fields(fs, sys, coordinate_of, f);
     if (fs.type == ForceSpec::Type::kUser) {
       f.law = find_force_law(fs.law);
@@ -179,8 +170,7 @@ void add_forces(const ModelIndex& index, System& sys, const NameIndex& coordinat
         f.parameters.push_back(it->second);
       }
     }
-    if (!force_of.emplace(f.name, static_cast<int>(sys.forces.size())).second)
-      fail(fs.where, "name", "force '" + f.name + "' is defined twice");
+    force_of.emplace(f.name, static_cast<int>(sys.forces.size()));
     sys.forces.push_back(f);
   }
 }
@@ -251,8 +241,7 @@ void add_sensors(const ModelIndex& index, System& sys, const NameIndex& coordina
         break;
       }
     }
-    if (!sensor_of.emplace(s.name, static_cast<int>(sys.sensors.size())).second)
-      fail(ss.where, "name", "sensor '" + s.name + "' is defined twice");
+    sensor_of.emplace(s.name, static_cast<int>(sys.sensors.size()));
     sys.sensors.push_back(s);
   }
 }

@@ -19,6 +19,7 @@
 #include "cases/scene/scene_validation.h"
 #include "core/errors.h"
 #include "core/expression.h"
+#include "formulation/cut_types.h"
 #include "formulation/formulation_registry.h"
 
 namespace mbdae::scene_load {
@@ -215,24 +216,16 @@ void Loader::cut(const YAML::Node& n, Model& m) {
   c.where = where(n);
   c.name = name(n);
   const std::string type = text(n, "type", "", true);
-  const Fields base = {"name", "type", "body1", "point1", "body2", "point2"};
-  auto with = [&](Fields extra) {
-    Fields f = base;
-    f.insert(f.end(), extra.begin(), extra.end());
-    return f;
-  };
-  if (type == "ball") c.type = CutSpec::Type::kBall;
-  else if (type == "revolute") c.type = CutSpec::Type::kRevolute;
-  else if (type == "universal") c.type = CutSpec::Type::kUniversal;
-  else if (type == "prismatic") c.type = CutSpec::Type::kPrismatic;
-  else if (type == "weld") c.type = CutSpec::Type::kWeld;
-  else if (type == "distance") c.type = CutSpec::Type::kDistance;
-  else if (!type.empty()) error(n["type"], "type", "unknown cut type " + quote(type) + " (ball, revolute, universal, prismatic, weld, distance)");
-  if (type == "ball") applies(n, "a ball cut", general, base);
-  if (type == "revolute" || type == "universal") applies(n, "a " + type + " cut", general, with({"axis1", "axis2"}));
-  if (type == "weld" || type == "prismatic")
-    applies(n, "a " + type + " cut", general, with({"axis1", "axis2", "ref1", "ref2"}));
-  if (type == "distance") applies(n, "a distance cut", general, with({"distance"}));
+  // The cut-type table (formulation/cut_types.h): the type and the fields that apply to it.
+  const CutType* row = find_cut_type(type);
+  if (row) {
+    c.type = row->type;
+    Fields fields = {"name", "type", "body1", "point1", "body2", "point2"};
+    fields.insert(fields.end(), row->fields.begin(), row->fields.end());
+    applies(n, "a " + type + " cut", general, fields);
+  } else if (!type.empty()) {
+    error(n["type"], "type", "unknown cut type " + quote(type) + " (" + cut_type_names() + ")");
+  }
   c.body1 = name(n, "body1");
   c.body2 = name(n, "body2");
   c.point1 = text(n, "point1", "");
