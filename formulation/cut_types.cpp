@@ -105,6 +105,21 @@ void prismatic(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
   }
 }
 
+// Rotation about and translation along a common axis: the axes parallel (as the revolute) and
+// point 2 on body 1's axis line (no offset across it, as the prismatic).
+void cylindrical(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
+  const Vec3 a1 = axis1(cut, s), a2 = axis2(cut, s);
+  const Vec3 n1 = a2.unitOrthogonal(), n2 = a2.cross(n1);
+  dot1(s, a1, n1, "axis1 _|_ n1", out);
+  dot1(s, a1, n2, "axis1 _|_ n2", out);
+  const Vec3 m1 = a1.unitOrthogonal(), m2 = a1.cross(m1);
+  for (const Vec3& m : {m1, m2}) {
+    Constraint c = cut_constraint(Constraint::Type::kDot2, s);
+    c.ai = m;
+    out.add(c, "no offset across the axis");
+  }
+}
+
 void distance(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
   Constraint c = cut_constraint(Constraint::Type::kDistance, s);
   c.distance = cut.distance;
@@ -122,6 +137,7 @@ const std::vector<CutType>& cut_types() {
       {"prismatic", T::kPrismatic, {"axis1", "axis2", "ref1", "ref2"}, true, prismatic},
       {"weld", T::kWeld, {"axis1", "axis2", "ref1", "ref2"}, true, weld},
       {"distance", T::kDistance, {"distance"}, false, distance},
+      {"cylindrical", T::kCylindrical, {"axis1", "axis2"}, false, cylindrical},
   };
   return rows;
 }

@@ -56,7 +56,7 @@ struct CoordinateSpec {
 
 // Loop-closure (cut) constraint between two bodies; "ground" is allowed as a body.
 struct CutSpec {
-  enum class Type { kBall, kRevolute, kUniversal, kPrismatic, kWeld, kDistance };
+  enum class Type { kBall, kRevolute, kUniversal, kPrismatic, kWeld, kDistance, kCylindrical };
   std::string name;
   Type type = Type::kBall;
   std::string body1, point1, body2, point2;

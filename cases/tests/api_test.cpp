@@ -3,6 +3,7 @@
 // like the file's own errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -377,6 +378,50 @@ TEST(RtolOverride, GivenAtolIsKept) {
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(dynamics_summary(r)["tolerances"]["atol_position"].get<double>(), 1e-9);
   EXPECT_FALSE(dynamics_summary(r)["tolerances"].contains("scene_atol_scaled_by"));
+}
+
+// The cylindrical cut (the cut-type recipe of docs/architecture.md, done once): a body on six
+// tree coordinates, held by a cylindrical cut to ground about the vertical axis, falls freely
+// along it and spins at its initial rate: z = z0 - g t^2 / 2, psi = w t, nothing across the axis.
+TEST(CutTypes, CylindricalCutFallsAndSpinsFreelyAlongItsAxis) {
+  const char* const text = R"(name: cylindrical
+gravity: [0, 0, -9.81]
+bodies:
+  - {name: sleeve, mass: 2.0, inertia: {xx: 0.05, yy: 0.05, zz: 0.02}}
+joints:
+  - {name: free, parent: ground, child: sleeve, chain: [T1, T2, T3, R1, R2, R3], coordinates: [x, y, z, a, b, psi]}
+coordinates:
+  x: {initial: 0}
+  y: {initial: 0}
+  z: {initial: 1}
+  a: {initial: 0}
+  b: {initial: 0}
+  psi: {initial: 0}
+cuts:
+  - {name: rail, type: cylindrical, body1: ground, body2: sleeve, axis1: [0, 0, 1]}
+sensors:
+  - {name: x, type: coordinate, coordinate: x}
+  - {name: z, type: coordinate, coordinate: z}
+  - {name: b, type: coordinate, coordinate: b}
+  - {name: psi, type: coordinate, coordinate: psi}
+analysis:
+  - {type: dynamics, t_end: 1.0, output_step: 0.05, rtol: 1e-9, initial_velocities: {psi: 3.0}}
+)";
+  const Result r = run(load_scene_text(text, "cylindrical.yaml"), RunOptions{});
+  ASSERT_TRUE(r.ok()) << r.message;
+  const auto &t = r.column("t"), &x = r.column("x"), &z = r.column("z"), &b = r.column("b"), &psi = r.column("psi");
+  double worst_z = 0, worst_psi = 0, worst_across = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    worst_z = std::max(worst_z, std::fabs(z[i] - (1.0 - 0.5 * 9.81 * t[i] * t[i])));
+    worst_psi = std::max(worst_psi, std::fabs(psi[i] - 3.0 * t[i]));
+    worst_across = std::max({worst_across, std::fabs(x[i]), std::fabs(b[i])});
+  }
+  std::printf("cylindrical cut over 1 s: |z - z_exact| %.2e m, |psi - w t| %.2e rad, across the axis %.2e\n",
+              worst_z, worst_psi, worst_across);
+  EXPECT_EQ(t.size(), 21u);
+  EXPECT_LT(worst_z, 1e-7 * 4.905);  // 100 rtol of the fall
+  EXPECT_LT(worst_psi, 1e-7 * 3.0);
+  EXPECT_LT(worst_across, 1e-9);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The cut-type table (formulation/cut_types.h): every CutSpec::Type has one row, found by its
 // scene name, and each row's equations remove the degrees of freedom its joint removes (ball 3,
-// universal 4, revolute 5, prismatic 5, weld 6, distance 1), with a Jacobian of that rank at a
-// generic configuration.
+// universal 4, revolute 5, prismatic 5, weld 6, distance 1, cylindrical 4), with a Jacobian of
+// that rank at a generic configuration.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -23,14 +23,14 @@ TEST(CutTypes, EveryTypeHasOneRowFoundByItsName) {
     EXPECT_NE(row.equations, nullptr) << row.name;
   }
   using T = CutSpec::Type;
-  for (T t : {T::kBall, T::kRevolute, T::kUniversal, T::kPrismatic, T::kWeld, T::kDistance})
+  for (T t : {T::kBall, T::kRevolute, T::kUniversal, T::kPrismatic, T::kWeld, T::kDistance, T::kCylindrical})
     EXPECT_EQ(cut_type(t).type, t);
   EXPECT_EQ(find_cut_type("hinge"), nullptr);
 }
 
 TEST(CutTypes, EquationsRemoveTheJointsDegreesOfFreedom) {
   const std::map<std::string, int> removed = {{"ball", 3}, {"universal", 4}, {"revolute", 5},
-                                              {"prismatic", 5}, {"weld", 6}, {"distance", 1}};
+                                              {"prismatic", 5}, {"weld", 6}, {"distance", 1}, {"cylindrical", 4}};
   // Two free bodies at generic poses; the cut's points and axes in their frames.
   Vec4 p1(0.9, 0.1, -0.3, 0.2), p2(0.8, -0.2, 0.4, 0.1);
   p1.normalize();
