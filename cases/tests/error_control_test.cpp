@@ -31,12 +31,7 @@ const std::string kStep = "cases/five_point_suspension/dynamics_step.yaml";
 
 test_support::CommandResult shell(const std::string& cmd) { return test_support::run_command(cmd); }
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_support::read_file;
 
 class ErrorControlCli : public ::testing::Test {
  protected:

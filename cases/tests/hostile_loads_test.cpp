@@ -26,12 +26,7 @@ using mbdae::test_support::run_command;
 
 std::string exe() { return std::string("'") + MBDAE_EXE + "'"; }
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using mbdae::test_support::read_file;
 
 // A crank (a disc on a revolute joint about z, no gravity) driven by `torque`, with a slider-crank
 // loop: a rod from the crank pin to a slider on the x axis. Fast: 2 N m on J = 0.5 from 50 rad/s.

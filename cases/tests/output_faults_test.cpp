@@ -53,12 +53,7 @@ CliResult shell(const std::string& cmd) { return mbdae::test_support::run_comman
 std::string sh_quote(const fs::path& p) { return "'" + p.string() + "'"; }
 std::string exe() { return std::string("'") + MBDAE_EXE + "'"; }
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using mbdae::test_support::read_file;
 
 // The rows of a CSV written by mbdae: every line ends with '\n', the header is the expected one
 // and every row has three numbers with increasing times. Returns the number of rows.

@@ -1,5 +1,5 @@
-// Runs a shell command line for the executable tests: its exit code and its output (stdout and
-// stderr together).
+// Support of the executable tests: a shell command line run with its exit code and its output
+// (stdout and stderr together), a file read whole, and a fresh folder per test.
 #pragma once
 
 #include <sys/wait.h>
@@ -10,6 +10,8 @@
 #include <array>
 #include <filesystem>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace mbdae::test_support {
@@ -29,6 +31,14 @@ inline CommandResult run_command(const std::string& cmd) {
   const int status = pclose(p);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// The whole content of a file, bytes as they are (empty if it cannot be read).
+inline std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 // A fresh folder per test (`dir`, removed afterwards) and the run's output folder `out` inside it:
