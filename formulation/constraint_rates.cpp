@@ -25,32 +25,30 @@ void row_hessians(const Constraint& c, const LocalState& s, Mat14* h) {
   }
 }
 
+// Phi_q v + Phi_t of one constraint, its Jacobian rows given.
+void velocity_rows(const Constraint& c, const Row14* rows, const double* v, double t, double* out) {
+  double pt[3], ptt[3];
+  constraint_time_derivatives(c, t, pt, ptt);
+  const Vec14 vl = gather_local(v, c.bi, c.bj);
+  for (int r = 0; r < c.rows(); ++r) out[r] = rows[r].dot(vl) + pt[r];
+}
 
 }  // namespace
 
 void velocity_constraint_values(const System& sys, const std::vector<int>& off, const double* q,
                                 const double* v, double t, double* out) {
   Row14 rows[3];
-  double pt[3], ptt[3];
   for (size_t k = 0; k < sys.constraints.size(); ++k) {
     const Constraint& c = sys.constraints[k];
     constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
-    constraint_time_derivatives(c, t, pt, ptt);
-    const Vec14 vl = gather_local(v, c.bi, c.bj);
-    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[r].dot(vl) + pt[r];
+    velocity_rows(c, rows, v, t, out + off[k]);
   }
 }
 
 void velocity_constraint_values(const System& sys, const std::vector<int>& off,
                                 const std::vector<Row14>& cached, const double* v, double t, double* out) {
-  double pt[3], ptt[3];
-  for (size_t k = 0; k < sys.constraints.size(); ++k) {
-    const Constraint& c = sys.constraints[k];
-    const Row14* rows = cached.data() + 3 * k;
-    constraint_time_derivatives(c, t, pt, ptt);
-    const Vec14 vl = gather_local(v, c.bi, c.bj);
-    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[r].dot(vl) + pt[r];
-  }
+  for (size_t k = 0; k < sys.constraints.size(); ++k)
+    velocity_rows(sys.constraints[k], cached.data() + 3 * k, v, t, out + off[k]);
 }
 
 void stabilized_acceleration_constraints(const System& sys, const std::vector<int>& off,

@@ -35,6 +35,11 @@ namespace {
 
 std::string indexed(const std::string& field, size_t k) { return field + "[" + std::to_string(k) + "]"; }
 
+// A problem at the line of its field (FieldLines), the field shown without its index.
+SceneIssue scene_issue(const ModelIssue& i, const FieldLines& lines) {
+  return {i.item.file, lines.line(i.item, i.field), i.shown_field(), i.message};
+}
+
 template <class Map>
 std::vector<std::string> keys(const Map& map) {
   std::vector<std::string> v;
@@ -54,7 +59,7 @@ struct SceneRules : ModelNames {
       : ModelNames(std::move(names)), scene(s), m(s.model), lines(l), issues(out) {}
 
   void report(const SourceLocation& item, const std::string& field, const std::string& message) {
-    issues.push_back({item.file, lines.line(item, field), ModelIssue{item, field, message, ""}.shown_field(), message});
+    issues.push_back(scene_issue({item, field, message, ""}, lines));
   }
   static std::string suggestion(const std::string& name, const std::vector<std::string>& candidates) {
     return did_you_mean(name, candidates);
@@ -167,7 +172,7 @@ struct SceneRules : ModelNames {
 void validate_scene(const Scene& scene, const FieldLines& lines, std::vector<SceneIssue>& issues) {
   ModelNames names;
   for (const ModelIssue& i : check_model(scene.model, &names))
-    issues.push_back({i.item.file, lines.line(i.item, i.field), i.shown_field(), i.message});
+    issues.push_back(scene_issue(i, lines));
   SceneRules rules(scene, std::move(names), lines, issues);
   rules.check_output();
   rules.check_steps();
