@@ -30,7 +30,7 @@ jobs=${MBDAE_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
 command -v "$cxx" >/dev/null || { echo "run_fuzz.sh: $cxx not found (apt-get install clang-14 libclang-rt-14-dev)" >&2; exit 1; }
 
 san=(-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
-cxxflags=(-std=c++17 -O1 -g "${san[@]}" -fsanitize=fuzzer-no-link
+cxxflags=(-std=c++17 -O1 -gline-tables-only "${san[@]}" -fsanitize=fuzzer-no-link
   -I"$root" -I/usr/include/eigen3 -I/usr/include/suitesparse
   -DMBDAE_FUZZ_SCENE_PATH="\"$here/scene.yaml\"" -Wno-unused-command-line-argument)
 # Libraries: yaml-cpp and every mbdae_import_library(TARGET name [OPTIONAL]) of
