@@ -3,7 +3,7 @@
 // `realtype`): the code uses it directly. How the 7 branch was checked: docs/sundials.md.
 #pragma once
 
-#include <ida/ida.h>
+#include <idas/idas.h>
 #include <sundials/sundials_config.h>
 #include <sundials/sundials_context.h>
 #include <sundials/sundials_linearsolver.h>

@@ -40,7 +40,7 @@ libs=(-lyaml-cpp -lz)  # zlib: the compressed .vtp frames of core/vtk_xml.cpp
 while read -r l optional; do
   if [[ -z "$optional" ]] || "$cxx" -l"$l" -shared -o /dev/null -x c /dev/null 2>/dev/null; then libs+=("-l$l"); fi
 done < <(sed -n 's/^[[:space:]]*mbdae_import_library([[:space:]]*[A-Za-z_0-9]*[[:space:]][[:space:]]*\([A-Za-z_0-9.+-]*\)[[:space:]]*\(OPTIONAL\)\{0,1\}[[:space:]]*).*/\1 \2/p' "$root/cases/package/mbdae_dependencies.cmake")
-[[ ${#libs[@]} -gt 2 ]] || libs+=(-lsundials_ida -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
+[[ ${#libs[@]} -gt 2 ]] || libs+=(-lsundials_idas -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lsundials_nvecserial -lklu)
 
 # Sources: those of the libraries mbdae_core, mbdae_formulation and mbdae_scene as listed in the
 # top-level CMakeLists.txt (all of core/, formulation/ and the loader if that cannot be read).

@@ -28,7 +28,7 @@ if(NOT MBDAE_KLU_INCLUDE_DIR)
   set(MBDAE_DEPENDENCIES_MISSING "${MBDAE_DEPENDENCIES_MISSING} klu.h")
 endif()
 mbdae_import_library(klu klu)
-mbdae_import_library(sundials_ida sundials_ida)
+mbdae_import_library(sundials_idas sundials_idas)  # IDAS: IDA with forward sensitivities (the same IDA for runs without)
 mbdae_import_library(sundials_nvecserial sundials_nvecserial)
 mbdae_import_library(sundials_sunmatrixsparse sundials_sunmatrixsparse)
 mbdae_import_library(sundials_core sundials_core OPTIONAL)
@@ -44,7 +44,7 @@ endif()
 
 # What mbdae_core and mbdae_formulation link (sundials_core last: the other SUNDIALS libraries
 # use it).
-set(MBDAE_CORE_DEPENDENCIES mbdae_dep::sundials_ida mbdae_dep::sundials_sunmatrixsparse
+set(MBDAE_CORE_DEPENDENCIES mbdae_dep::sundials_idas mbdae_dep::sundials_sunmatrixsparse
     mbdae_dep::sundials_nvecserial mbdae_dep::klu)
 if(TARGET mbdae_dep::sundials_core)
   list(APPEND MBDAE_CORE_DEPENDENCIES mbdae_dep::sundials_core)
