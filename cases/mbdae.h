@@ -59,6 +59,10 @@ struct RunOptions {
   // Set from another thread (or a signal handler) to stop at the next step; the run then ends
   // with status "interrupted" and keeps what it computed.
   const std::atomic<bool>* stop = nullptr;
+  // Parameter paths (as set_parameter takes them) to differentiate every output sensor by:
+  // forward sensitivities integrated with the run (IDAS), Result::sensitivities
+  // (docs/sensitivities.md). A path that names no number of the model is refused before the run.
+  std::vector<std::string> sensitivities;
 };
 
 // The names of the registered formulations (index3, index2-ggl, index1, penalty, ...).
@@ -80,6 +84,12 @@ struct Result {
   // System with one holding their values; a built System is never changed), for what draws or
   // evaluates the final configuration (the animation of a static run).
   std::shared_ptr<const System> system;
+  // With RunOptions::sensitivities: "t", then "d(SENSOR)/d(PATH)" for each output sensor and
+  // each parameter (sensor by sensor, the parameters in the order asked), with their units, at
+  // the samples of `data` (column-major). Fewer rows than `data` where they failed
+  // (summary.json "sensitivities": status and message).
+  std::vector<std::string> sensitivity_columns, sensitivity_units;
+  std::vector<std::vector<double>> sensitivities;
 
   bool ok() const { return status == "ok"; }
   size_t rows() const { return data.empty() ? 0 : data[0].size(); }

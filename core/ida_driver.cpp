@@ -39,6 +39,9 @@ struct UserData {
   std::string callback_status;  // a SolveError's status (a load that is not finite), else empty
   int non_finite = -1;         // a component of y found not finite by weights_fn
   double non_finite_value = 0;
+  SensitivityProblem* sens = nullptr;  // IdaOptions::sensitivities
+  std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
+  std::vector<double*> r_out;
 };
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
@@ -110,6 +113,25 @@ int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector
   }
 }
 
+// The sensitivity equations' residual (IdaOptions::sensitivities), for every parameter at once.
+int sensitivity_residual_fn(int ns, sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, N_Vector* s, N_Vector* sp,
+                            N_Vector* rs, void* ud, N_Vector, N_Vector, N_Vector) {
+  auto* u = static_cast<UserData*>(ud);
+  for (int i = 0; i < ns; ++i) {
+    u->s_in[i] = N_VGetArrayPointer(s[i]);
+    u->sp_in[i] = N_VGetArrayPointer(sp[i]);
+    u->r_out[i] = N_VGetArrayPointer(rs[i]);
+  }
+  try {
+    return u->sens->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r), u->s_in.data(),
+                             u->sp_in.data(), u->r_out.data());
+  } catch (const SolveError& e) {
+    return callback_solve_error(u, e);
+  } catch (const std::exception& e) {
+    return callback_failed(u, "sensitivity residual", e);
+  }
+}
+
 int root_fn(sunrealtype t, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
   static_cast<UserData*>(ud)->problem->switches(t, N_VGetArrayPointer(y), g);
   return 0;
@@ -136,6 +158,12 @@ void collect(void* mem, IdaStats& s) {
   check(IDAGetNumErrTestFails(mem, &v), "IDAGetNumErrTestFails"); s.error_test_failures += v;
   check(IDAGetNumNonlinSolvIters(mem, &v), "IDAGetNumNonlinSolvIters"); s.nonlinear_iterations += v;
   check(IDAGetNumNonlinSolvConvFails(mem, &v), "IDAGetNumNonlinSolvConvFails"); s.nonlinear_failures += v;
+  if (IDAGetSensNumResEvals(mem, &v) == IDA_SUCCESS) {  // IDA_NO_SENS without sensitivities
+    s.sensitivity_residual_evals += v;
+    check(IDAGetSensNumNonlinSolvIters(mem, &v), "IDAGetSensNumNonlinSolvIters"); s.sensitivity_nonlinear_iterations += v;
+    check(IDAGetSensNumErrTestFails(mem, &v), "IDAGetSensNumErrTestFails"); s.sensitivity_error_test_failures += v;
+    check(IDAGetSensNumNonlinSolvConvFails(mem, &v), "IDAGetSensNumNonlinSolvConvFails"); s.sensitivity_nonlinear_failures += v;
+  }
   double h = 0;
   if (IDAGetLastStep(mem, &h) == IDA_SUCCESS && h != 0) s.last_step = h;
 }
@@ -189,6 +217,12 @@ struct IdaRun {
   long watch_steps = 0;  // steps since watch_t (the step budget, IdaOptions::max_total_steps)
   double watch_t = 0;
   int watch_strikes = 0;  // windows in a row whose rate projects more than the budget
+  // Sensitivities (IdaOptions::sensitivities): ns vectors each of s and s' (the state's, kept
+  // between IDAS calls) and of a sample's interpolated ones; their data pointers.
+  int ns = 0;
+  N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
+  std::vector<double*> s_data, sp_data, ss_data, sps_data;
+  std::vector<double> pbar;
 
   IdaRun() = default;
   IdaRun(const IdaRun&) = delete;
@@ -199,11 +233,19 @@ struct IdaRun {
     if (jac) SUNMatDestroy(jac);
     for (N_Vector v : {y, yp, id, ys, yps})
       if (v) N_VDestroy(v);
+    for (N_Vector* v : {s, sp, ss, sps})
+      if (v) N_VDestroyVectorArray(v, ns);
     if (ctx) SUNContext_Free(&ctx);
   }
 };
 
 double* data(N_Vector v) { return N_VGetArrayPointer(v); }
+
+std::vector<double*> data(N_Vector* v, int n) {
+  std::vector<double*> out(n);
+  for (int i = 0; i < n; ++i) out[i] = data(v[i]);
+  return out;
+}
 
 void choose_initial_step(IdaRun& r, double tt) {
   if (r.o->initial_step > 0) return;
@@ -237,6 +279,31 @@ void configure_ida(IdaRun& r) {
     check(IDASetNoInactiveRootWarn(r.mem), "IDASetNoInactiveRootWarn");
   }
   r.roots.assign(std::max(1, r.nsw), 0);
+}
+
+// IDAS's forward sensitivities (IdaOptions::sensitivities): consistent initial values from the
+// problem; the staggered corrector (the sensitivities' Newton iterations after the state's, on
+// its Newton matrix); error weights those of the state at pbar_i s_i (IDASensEEtolerances).
+void open_sensitivities(IdaRun& r) {
+  SensitivityProblem* sp = r.o->sensitivities;
+  if (!sp) return;
+  r.ns = sp->count();
+  for (N_Vector** v : {&r.s, &r.sp, &r.ss, &r.sps}) *v = check(N_VCloneVectorArray(r.ns, r.y), "N_VCloneVectorArray");
+  r.s_data = data(r.s, r.ns);
+  r.sp_data = data(r.sp, r.ns);
+  r.ss_data = data(r.ss, r.ns);
+  r.sps_data = data(r.sps, r.ns);
+  r.ud.sens = sp;
+  r.ud.s_in.resize(r.ns);
+  r.ud.sp_in.resize(r.ns);
+  r.ud.r_out.resize(r.ns);
+  sp->initial(r.o->t0, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
+  check(IDASensInit(r.mem, r.ns, IDA_STAGGERED, sensitivity_residual_fn, r.s, r.sp), "IDASensInit");
+  check(IDASensEEtolerances(r.mem), "IDASensEEtolerances");
+  r.pbar.resize(r.ns);
+  for (int i = 0; i < r.ns; ++i) r.pbar[i] = sp->scale(i);
+  check(IDASetSensParams(r.mem, nullptr, r.pbar.data(), nullptr), "IDASetSensParams");
+  check(IDASetSensErrCon(r.mem, sp->in_error_test() ? SUNTRUE : SUNFALSE), "IDASetSensErrCon");
 }
 
 // Breakpoints inside the span end segments. One at t1 makes the end a stop time (next_stop).
@@ -273,6 +340,7 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   configure_ida(r);
   find_breakpoints(r);
   r.with_derivative = r.problem->output_needs_derivative();
+  open_sensitivities(r);
   r.t = r.t_prev = o.t0;
   r.y_prev = y0;
   r.yp_prev = yp0;
@@ -306,6 +374,20 @@ bool interpolate(IdaRun& r, double tt, int k, N_Vector v) {
   return false;
 }
 
+// IDAS's interpolants of s_i and s_i' at tt (nothing without sensitivities).
+bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) {
+  for (int i = 0; i < r.ns; ++i) {
+    for (int k = 0; k < 2; ++k) {
+      const int flag = IDAGetSensDky1(r.mem, tt, k, i, k == 0 ? s[i] : sp[i]);
+      if (flag == IDA_SUCCESS) continue;
+      fail(r, "integration_failed",
+           "interpolating the sensitivities at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
+      return false;
+    }
+  }
+  return true;
+}
+
 // IDA stopped with an error: the message names the worst error estimates and IDA's own words.
 void ida_failure(IdaRun& r, int flag) {
   double tt = r.t;
@@ -336,10 +418,12 @@ double sample_time(const IdaRun& r, long k) {
 
 // One sample to the caller, after checking it: a SolveError thrown there (a sensor that is not
 // finite) ends the run like a failure of the solver.
-void emit(IdaRun& r, double ts, const double* yy, const double* yyp) {
+void emit(IdaRun& r, double ts, const double* yy, const double* yyp, double* const* s, double* const* sp) {
   if (!finite(r, yy, ts, "") || (yyp && !finite(r, yyp, ts, "derivative of "))) return;
   try {
-    if (!(*r.output)(ts, yy, yyp)) r.stop_requested = true;
+    const bool go_on = (*r.output)(ts, yy, yyp);
+    if (r.ns > 0 && r.o->sensitivity_output) r.o->sensitivity_output(ts, yy, yyp, s, sp);
+    if (!go_on) r.stop_requested = true;
   } catch (const SolveError& e) {
     fail(r, e.status, e.what(), ts);
   }
@@ -351,8 +435,10 @@ void emit_until(IdaRun& r, double t_reached) {
   while (!r.stop_requested && r.stats.ok && r.sample_index >= 0) {
     const double ts = sample_time(r, r.sample_index);
     if (ts > t_reached) break;
-    if (!interpolate(r, ts, 0, r.ys) || (r.with_derivative && !interpolate(r, ts, 1, r.yps))) break;
-    emit(r, ts, data(r.ys), r.with_derivative ? data(r.yps) : nullptr);
+    if (!interpolate(r, ts, 0, r.ys) || (r.with_derivative && !interpolate(r, ts, 1, r.yps)) ||
+        !interpolate_sensitivities(r, ts, r.ss, r.sps))
+      break;
+    emit(r, ts, data(r.ys), r.with_derivative ? data(r.yps) : nullptr, r.ss_data.data(), r.sps_data.data());
     if (ts >= r.o->t1) {
       r.sample_index = -1;
       break;
@@ -385,6 +471,7 @@ void keep_step(IdaRun& r) {
 void reinit(IdaRun& r, double tt) {
   collect(r.mem, r.stats);
   check(IDAReInit(r.mem, tt, r.y, r.yp), "IDAReInit");
+  if (r.ns > 0) check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
 }
 
 // A step past t1: the end state and the last samples are interpolated; a root beyond t1 is no
@@ -403,6 +490,9 @@ bool step_onto_root(IdaRun& r, double t_root) {
   choose_initial_step(r, r.t_prev);
   r.ud.h_initial = std::min(r.ud.h_initial, t_root - r.t_prev);
   if (r.ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
+    // The sensitivities at the last accepted step, from IDAS's interpolant (it passes through
+    // that step's solution), before IDA's history is reset.
+    if (!interpolate_sensitivities(r, r.t_prev, r.s, r.sp)) return false;
     std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
     std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
     check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
@@ -438,6 +528,11 @@ bool restart(IdaRun& r, const int* roots) {
   r.problem->set_segment(r.t, segment_end(r));
   try {
     r.problem->restart(r.t, data(r.y), data(r.yp), roots);
+    if (r.ns > 0) {  // the sensitivities at t (IDAS's), made consistent with the restarted state
+      r.o->sensitivities->set_segment(r.t, segment_end(r));
+      if (!interpolate_sensitivities(r, r.t, r.s, r.sp)) return false;
+      r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
+    }
   } catch (const SolveError& e) {
     fail(r, e.status, std::string("restart at t = ") + std::to_string(r.t) + " failed: " + e.what(), r.t);
     return false;
@@ -530,12 +625,20 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   r.problem = &problem;
   r.o = &o;
   r.output = &output;
-  open_run(r, y0, yp0);
+  try {
+    open_run(r, y0, yp0);
+  } catch (const SolveError& e) {  // initial sensitivities that cannot be made, a refused setting
+    if (!r.mem) throw;
+    fail(r, e.status, e.what(), o.t0);
+    r.stats.cpu_seconds = cpu_now() - cpu0;
+    return r.stats;
+  }
   // The first sample is the initial state.
-  emit(r, o.t0, y0.data(), yp0.data());
+  emit(r, o.t0, y0.data(), yp0.data(), r.s_data.data(), r.sp_data.data());
   r.sample_index = 1;
   check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
   problem.set_segment(r.t, segment_end(r));
+  if (r.ns > 0) o.sensitivities->set_segment(r.t, segment_end(r));
   r.watch_t = o.t0;
   while (!r.stop_requested && r.stats.ok && r.t < o.t1) {
     if (o.stop && o.stop->load(std::memory_order_relaxed)) break;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/dae_problem.h"
+#include "core/sensitivity_problem.h"
 
 namespace mbdae {
 
@@ -39,6 +40,12 @@ struct IdaOptions {
   // until two tests at the noise floor are revisited (docs/performance.md, "The reduced Newton
   // solve").
   bool reduced_newton = false;
+  // Forward sensitivities of the solution (IDAS, core/sensitivity_problem.h), or null. Each
+  // sample's (t, y, y', s_i, s_i') go to sensitivity_output right after the sample went to
+  // `output` (y' null where `output` gets none).
+  SensitivityProblem* sensitivities = nullptr;
+  std::function<void(double, const double*, const double*, const double* const*, const double* const*)>
+      sensitivity_output;
 };
 
 struct IdaStats {
@@ -48,6 +55,9 @@ struct IdaStats {
   long fresh_factorizations = 0;  // KLU factorizations with a new pivot order (others refactor)
   std::vector<double> event_times;      // located switching events
   std::vector<double> breakpoint_times;  // stops at input discontinuities
+  // The sensitivity equations' own work (IdaOptions::sensitivities; 0 without).
+  long sensitivity_residual_evals = 0, sensitivity_nonlinear_iterations = 0;
+  long sensitivity_error_test_failures = 0, sensitivity_nonlinear_failures = 0;
   double cpu_seconds = 0;
   double last_step = 0;
   double t_reached = 0;

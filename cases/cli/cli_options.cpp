@@ -7,6 +7,7 @@
 
 #include "cases/scene/analysis_types.h"
 #include "cases/scene/field_ranges.h"
+#include "cases/run/sensitivities.h"
 
 namespace mbdae {
 namespace {
@@ -67,6 +68,10 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
     }
     return "";
   }
+  if (a == "--sensitivity" && has_value) {  // repeatable
+    opt.sensitivities.push_back(args[++i]);
+    return "";
+  }
   if (a == "--animation") {
     cl.animation = true;
     return "";
@@ -92,7 +97,7 @@ void print_usage() {
   for (const std::string& f : formulations()) names += (names.empty() ? "" : "|") + f;
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
-               "                  [--error-target E] [--error-sensors a,b]\n"
+               "                  [--error-target E] [--error-sensors a,b] [--sensitivity PATH]...\n"
                "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation %s]\n"
                "       mbdae check SCENE.yaml\n"
@@ -145,6 +150,7 @@ std::vector<std::string> run_option_errors(const Scene& scene, const RunOptions&
       out.push_back("formulation: expected one of " + list + ", got '" + opt.formulation + "'");
     }
   }
+  for (std::string& m : check_sensitivity_paths(scene, opt.sensitivities, "sensitivities")) out.push_back(std::move(m));
   if (out.empty())
     for (const std::string& m : check_overrides(scene, opt)) out.push_back("output_step" + m.substr(m.find(':')));
   return out;
@@ -163,6 +169,7 @@ std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& o
 
 std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl) {
   std::vector<std::string> out = check_error_sensors(scene, cl.error.sensors, "--error-sensors");
+  for (std::string& m : check_sensitivity_paths(scene, cl.options.sensitivities, "--sensitivity")) out.push_back(std::move(m));
   for (std::string& m : check_overrides(scene, cl.options)) out.push_back(std::move(m));
   return out;
 }

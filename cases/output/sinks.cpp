@@ -1,5 +1,9 @@
 #include "cases/output/sinks.h"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 namespace mbdae {
 
 void CsvSink::begin(const RunInfo& info) { csv_.open(path_, *info.columns); }
@@ -11,6 +15,19 @@ void CsvSink::sample(const Sample& s) {
 
 void CsvSink::end(const Result&) { csv_.close(); }
 
+void SensitivityCsvSink::end(const Result& r) {
+  if (r.sensitivity_columns.empty()) return;
+  CsvWriter csv;
+  csv.open(path_, r.sensitivity_columns);
+  std::vector<double> row(r.sensitivity_columns.size());
+  const size_t rows = r.sensitivities.empty() ? 0 : r.sensitivities[0].size();
+  for (size_t i = 0; i < rows; ++i) {
+    for (size_t k = 0; k < row.size(); ++k) row[k] = r.sensitivities[k][i];
+    csv.row(row.data());
+  }
+  csv.close();
+}
+
 void SummarySink::end(const Result& result) { write_json_file(path_, result.summary); }
 
 RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
@@ -19,7 +36,11 @@ RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
   // is claimed or changed (cases/output/animation_sink.h).
   if (!request.animation_dir.empty()) check_animation_size(scene, request.animation_dir, request.animation_rate);
   if (!request.out_dir.empty()) {
-    s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json"});
+    s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json", "sensitivities.csv"});
+    // An earlier run's sensitivities, which this run does not replace.
+    const std::string old = request.out_dir + "/sensitivities.csv";
+    if (!request.sensitivities && std::remove(old.c_str()) != 0 && errno != ENOENT)
+      throw OutputError("cannot remove the previous run's " + old + ": " + std::strerror(errno));
     // An earlier run's animation files, when this run writes none there.
     if (request.animation_dir != request.out_dir) remove_animation_files(request.out_dir);
   }
@@ -32,7 +53,12 @@ void renew_sinks(const Scene& scene, const OutputRequest& request, RunSinks& s) 
   if (!request.out_dir.empty()) {
     s.csv = std::make_unique<CsvSink>(request.out_dir + "/results.csv");
     s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
-    s.list = {s.csv.get(), s.summary.get()};
+    s.list = {s.csv.get()};
+    if (request.sensitivities) {
+      s.sensitivities = std::make_unique<SensitivityCsvSink>(request.out_dir + "/sensitivities.csv");
+      s.list.push_back(s.sensitivities.get());
+    }
+    s.list.push_back(s.summary.get());
   }
   if (!request.animation_dir.empty()) {
     if (request.animation_dir != request.out_dir) prepare_output_folder(request.animation_dir);

@@ -27,6 +27,17 @@ class CsvSink : public Sink {
   CsvWriter csv_;
 };
 
+// sensitivities.csv (RunOptions::sensitivities) when the run ends: Result::sensitivities, the
+// rows computed (also of a failed run), through PATH.partial like results.csv.
+class SensitivityCsvSink : public Sink {
+ public:
+  explicit SensitivityCsvSink(std::string path) : path_(std::move(path)) {}
+  void end(const Result& result) override;
+
+ private:
+  std::string path_;
+};
+
 // summary.json at the end of the run (written atomically: core/output.h write_json_file).
 class SummarySink : public Sink {
  public:
@@ -43,6 +54,7 @@ struct OutputRequest {
   std::string out_dir;
   std::string animation_dir;
   double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
+  bool sensitivities = false;  // out_dir/sensitivities.csv (else an earlier run's is removed)
 };
 
 // The sinks of one run and the lock of its output folder, held until the run ends. The one
@@ -50,6 +62,7 @@ struct OutputRequest {
 struct RunSinks {
   OutputFolderLock lock;
   std::unique_ptr<CsvSink> csv;
+  std::unique_ptr<SensitivityCsvSink> sensitivities;
   std::unique_ptr<SummarySink> summary;
   std::unique_ptr<AnimationSink> animation;
   std::vector<Sink*> list;  // what run() takes

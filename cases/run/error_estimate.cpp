@@ -208,6 +208,7 @@ RunOptions comparison_options(const Scene& scene, const RunOptions& options, dou
                               const std::atomic<bool>* stop) {
   RunOptions c = options;
   c.verbose = c.progress = c.report_failures = false;
+  c.sensitivities.clear();  // the estimate compares the outputs only
   c.stop = stop;
   const double rtol = run_rtol(scene, options);
   // Tighter (rtol / factor) unless that leaves the tolerance's range: then looser by the same factor.
@@ -237,6 +238,7 @@ ErrorEstimate compare_runs(const Scene& scene, const RunOptions& options, const 
   // Same steps, same answer: compare with a second formulation at the run's own tolerances.
   RunOptions other = options;
   other.verbose = other.progress = other.report_failures = false;
+  other.sensitivities.clear();
   other.rtol = e.rtol;
   other.atol = e.atol;
   other.formulation = e.formulation.rfind("index3", 0) == 0 ? "index2-ggl" : "index3";

@@ -9,6 +9,7 @@
 #include "cases/scene/analysis_types.h"
 #include "cases/run/failure_diagnosis.h"
 #include "cases/run/run_stages.h"
+#include "cases/run/sensitivities.h"
 #include "cases/scene/step_tolerances.h"
 #include "core/errors.h"
 #include "core/finite_check.h"
@@ -17,6 +18,7 @@
 #include "formulation/initial_velocities.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
+#include "formulation/twin_sensitivities.h"
 
 namespace mbdae {
 namespace {
@@ -54,9 +56,9 @@ IdaOptions integration_options(const RunOptions& opt, const AnalysisStep& step, 
   return io;
 }
 
-// The DAE of the step's formulation, made by its registry entry.
-std::unique_ptr<MultibodyDae> make_dae(const System& sys, const Formulation& f, const AnalysisStep& step,
-                                       const StepTolerances& tol, json& js) {
+// The parameters of the step's formulation.
+FormulationParameters formulation_parameters(const System& sys, const Formulation& f, const AnalysisStep& step,
+                                             const StepTolerances& tol, json& js) {
   // Index 3 scales its constraint rows like cj^2 M; the GGL and index-1 rows are scaled by
   // KLU's row scaling well enough (measured: no difference), so 1 unless the scene sets one.
   FormulationParameters p;
@@ -72,6 +74,12 @@ std::unique_ptr<MultibodyDae> make_dae(const System& sys, const Formulation& f, 
     js["baumgarte_alpha"] = p.baumgarte_alpha;
     js["baumgarte_beta"] = p.baumgarte_beta;
   }
+  return p;
+}
+
+// The DAE of the step's formulation, made by its registry entry.
+std::unique_ptr<MultibodyDae> make_dae(const System& sys, const Formulation& f, const FormulationParameters& p,
+                                       const StepTolerances& tol) {
   std::unique_ptr<MultibodyDae> dae = f.make(sys, p);
   dae->set_absolute_tolerances(tol.absolute);
   return dae;
@@ -228,6 +236,36 @@ struct Sampler {
   }
 };
 
+// The sensitivities' twins for this step (cases/run/sensitivities.h): each twin's DAE with the
+// run's formulation parameters, started from the twin's own chain of stages. Null when the
+// sensitivities are off or a twin cannot start (they then stop; the run goes on).
+std::unique_ptr<TwinSensitivities> twin_sensitivities(RunContext& c, const AnalysisStep& step, MultibodyDae& dae,
+                                                      const Formulation& f, const FormulationParameters& fp,
+                                                      const StepTolerances& tol) {
+  if (!c.sensitivities || !c.sensitivities->active) return nullptr;
+  const int k = static_cast<int>(&step - c.scene.steps.data());
+  std::vector<ParameterTwins> twins;
+  for (size_t i = 0; i < c.sensitivities->parameters.size(); ++i) {
+    const SensitivityParameter& p = c.sensitivities->parameters[i];
+    ParameterTwins pt;
+    pt.delta = p.delta;
+    pt.scale = p.scale;
+    for (int side = 0; side < 2; ++side) {
+      RunContext& t = *twin_context(c, i, side);
+      std::unique_ptr<MultibodyDae> td = make_dae(*t.system, f, fp, tol);
+      json tj;
+      if (!start(t, t.scene.steps[k], *td, side == 0 ? pt.y_plus : pt.y_minus, side == 0 ? pt.yp_plus : pt.yp_minus, tj)) {
+        sensitivities_failed(c, "twin_failed", "the twin of " + p.path + " cannot start analysis step " +
+                                                   std::to_string(k) + ": " + t.result.message);
+        return nullptr;
+      }
+      (side == 0 ? pt.plus : pt.minus) = std::move(td);
+    }
+    twins.push_back(std::move(pt));
+  }
+  return std::make_unique<TwinSensitivities>(dae, make_dae(*c.system, f, fp, tol), std::move(twins), false);
+}
+
 json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
   json stats;
   stats["steps"] = st.steps;
@@ -284,8 +322,9 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   js["integrator"] = f->integrator_name;
   const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
   const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
-  const IdaOptions io = integration_options(c.options, step, tol, js);
-  const std::unique_ptr<MultibodyDae> dae = make_dae(sys, *f, step, tol, js);
+  IdaOptions io = integration_options(c.options, step, tol, js);
+  const FormulationParameters fp = formulation_parameters(sys, *f, step, tol, js);
+  const std::unique_ptr<MultibodyDae> dae = make_dae(sys, *f, fp, tol);
   // The solve used: the reduced one only where the formulation has the kinematic rows.
   js["newton_solve"] = io.reduced_newton && dae->kinematic_rows() > 0 ? "reduced" : "full";
   std::vector<double> y, yp;
@@ -300,12 +339,22 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   }
   SetAsideWatch watch(c, tol, io.rtol);
   Sampler sampler(c, step, *dae, watch, io.output_step);
+  const std::unique_ptr<TwinSensitivities> ts = twin_sensitivities(c, step, *dae, *f, fp, tol);
+  if (ts) {
+    io.sensitivities = ts.get();
+    io.sensitivity_output = [&](double t, const double* yy, const double* yyp, const double* const* s,
+                                const double* const* sp) {
+      record_sensitivity_sample(c, *ts, t, yy, yyp, s, sp, step.output_projection);
+    };
+  }
   const size_t rows_before = c.result.rows();
   const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
   std::copy(y.begin(), y.begin() + sys.nq(), c.q.begin());
   c.turns = dae->state().turns;
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
+  if (ts) sensitivity_statistics(c, st, js["statistics"]);
+  follow_integration_stage(c);
   js["event_times"] = st.event_times;
   js["breakpoint_times"] = st.breakpoint_times;
   js["t_reached"] = st.t_reached;

@@ -5,6 +5,7 @@
 
 #include "cases/scene/analysis_types.h"
 #include "cases/run/run_stages.h"
+#include "cases/run/sensitivities.h"
 #include "core/errors.h"
 #include "core/output.h"
 #include "formulation/augmented_solver.h"
@@ -143,6 +144,7 @@ json sensors_json(const System& sys, const std::vector<char>& modes, const doubl
 }
 
 void close_summary(RunContext& c) {
+  close_sensitivities(c);
   if (!c.warnings.empty()) c.result.summary["warnings"] = c.warnings;
   c.result.summary["steps"] = c.steps;
 }
@@ -209,9 +211,11 @@ std::vector<std::vector<double>> Result::row_major() const {
 
 namespace {
 
-bool run_step(RunContext& c, const AnalysisStep& step) {
+bool run_step(RunContext& c, int k) {
+  const AnalysisStep& step = c.scene.steps[k];
   json js;
   const bool ok = analysis_type(step.type).stage(c, step, js);
+  if (ok && !integrates(step)) follow_static_stage(c, k, js);  // integration stages carry their own
   if (ok) c.steps.push_back(js);
   return ok;
 }
@@ -236,9 +240,10 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
                all_equations, {}, {}};
   c.q = c.system->q0;
   output_columns(c);
+  c.sensitivities = open_sensitivities(c);
   const int last = options.analysis >= 0 ? options.analysis : static_cast<int>(scene.steps.size()) - 1;
   for (int k = 0; k <= last && k < static_cast<int>(scene.steps.size()); ++k)
-    if (!run_step(c, scene.steps[k])) break;
+    if (!run_step(c, k)) break;
   if (result.exit_code == 0) {
     summary["status"] = "ok";
     close_summary(c);

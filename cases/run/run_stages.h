@@ -21,6 +21,8 @@
 
 namespace mbdae {
 
+struct RunSensitivities;
+
 struct RunContext {
   const Scene& scene;
   const RunOptions& options;
@@ -35,6 +37,8 @@ struct RunContext {
   // Whole turns of the rotation coordinates at the end of the last integration step, so that the
   // next one starts with the same count (formulation/system.h, CoordinateTurns).
   std::optional<CoordinateTurns> turns = std::nullopt;
+  // The twins that carry the sensitivities through the stages (cases/run/sensitivities.h), or null.
+  std::shared_ptr<RunSensitivities> sensitivities = nullptr;
 };
 
 std::shared_ptr<const System> build_checked_system(const Scene& scene, const RunOptions& options,

@@ -1,0 +1,245 @@
+// Sensitivities of a run's outputs to scene parameters: the twins and what they follow
+// (cases/run/sensitivities.h).
+#include "cases/run/sensitivities.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "cases/run/run_stages.h"
+#include "cases/scene/analysis_types.h"
+#include "core/errors.h"
+#include "core/finite_check.h"
+#include "formulation/mechanics.h"  // initial_modes
+#include "formulation/model_rules.h"  // did_you_mean
+#include "formulation/twin_sensitivities.h"
+
+namespace mbdae {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+bool read_number(const std::string& text, double& v) {
+  char* end = nullptr;
+  v = std::strtod(text.c_str(), &end);
+  return !text.empty() && end && *end == '\0' && std::isfinite(v);
+}
+
+// Analysis settings are not parameters of the model, except the initial rates of joints.
+bool analysis_setting(const std::string& path) {
+  return path.rfind("analysis.", 0) == 0 && path.find(".initial_velocities.") == std::string::npos;
+}
+
+std::string number_text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// "m/(N/m)": a sensitivity's unit from the sensor's and the parameter's.
+std::string ratio_unit(const std::string& y, const std::string& p) {
+  if (p.empty() || p == "1") return y;
+  const bool compound = p.find_first_of("/ *^") != std::string::npos;
+  return (y.empty() ? "1" : y) + "/" + (compound ? "(" + p + ")" : p);
+}
+
+std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParameter& p, double value) {
+  auto tw = std::make_unique<TwinRun>();
+  tw->scene = with_parameters(c.scene, {{p.path, number_text(value)}});
+  tw->options = c.options;
+  tw->options.verbose = tw->options.progress = tw->options.report_failures = false;
+  tw->options.sensitivities.clear();
+  json summary;
+  std::shared_ptr<const System> all;
+  std::shared_ptr<const System> sys = build_checked_system(tw->scene, tw->options, summary, &all);
+  if (sys->nq() != c.system->nq() || sys->num_constraint_rows() != c.system->num_constraint_rows())
+    throw ModelError(c.scene.file, 0, "sensitivities",
+                     "'" + p.path + "' changes the model's coordinates or equations (" +
+                         std::to_string(sys->num_constraint_rows()) + " constraint equations at " + number_text(value) +
+                         " against " + std::to_string(c.system->num_constraint_rows()) + "): it cannot be differentiated");
+  tw->context = std::make_unique<RunContext>(RunContext{tw->scene, tw->options, tw->sinks, tw->result, sys, all, {}, {}});
+  tw->context->q = sys->q0;
+  output_columns(*tw->context);
+  return tw;
+}
+
+}  // namespace
+
+std::vector<std::string> check_sensitivity_paths(const Scene& scene, const std::vector<std::string>& paths,
+                                                 const std::string& option) {
+  std::vector<std::string> out;
+  if (paths.empty()) return out;
+  std::vector<ParameterEntry> entries;
+  try {
+    entries = scene_parameters(scene);
+  } catch (const SceneError& e) {
+    return {option + ": " + (e.messages.empty() ? std::string(e.what()) : e.messages.front())};
+  }
+  std::vector<std::string> names;
+  for (const ParameterEntry& e : entries) names.push_back(e.path);
+  for (size_t i = 0; i < paths.size(); ++i) {
+    const std::string& path = paths[i];
+    const std::string head = option + " '" + path + "': ";
+    auto it = std::find_if(entries.begin(), entries.end(), [&](const ParameterEntry& e) { return e.path == path; });
+    double v = 0;
+    if (std::find(paths.begin(), paths.begin() + i, path) != paths.begin() + i)
+      out.push_back(head + "asked twice");
+    else if (it == entries.end())
+      out.push_back(head + "no such parameter (`mbdae params SCENE` lists them)" + did_you_mean(path, names));
+    else if (analysis_setting(path))
+      out.push_back(head + "a setting of the analysis, not a parameter of the model: it cannot be differentiated");
+    else if (!read_number(it->value, v))
+      out.push_back(head + "names '" + it->value + "' (" + it->file + ":" + std::to_string(it->line) +
+                    "), not a single number" + (it->value.rfind('[', 0) == 0 ? "; name one element: " + path + ".0" : ""));
+  }
+  return out;
+}
+
+std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c) {
+  const std::vector<std::string>& paths = c.options.sensitivities;
+  if (paths.empty()) return nullptr;
+  const std::vector<std::string> problems = check_sensitivity_paths(c.scene, paths, "sensitivities");
+  if (!problems.empty()) throw ModelError(c.scene.file, 0, "sensitivities", problems.front());
+  const std::vector<ParameterEntry> entries = scene_parameters(c.scene);
+  auto rs = std::make_shared<RunSensitivities>();
+  for (const std::string& path : paths) {
+    const ParameterEntry& e = *std::find_if(entries.begin(), entries.end(), [&](const ParameterEntry& x) { return x.path == path; });
+    SensitivityParameter p;
+    p.path = path;
+    p.unit = e.unit;
+    read_number(e.value, p.value);
+    p.scale = p.value != 0 ? std::fabs(p.value) : 1.0;
+    p.delta = kRelativeStep * p.scale;
+    p.twin[0] = make_twin(c, p, p.value + p.delta);
+    p.twin[1] = make_twin(c, p, p.value - p.delta);
+    rs->parameters.push_back(std::move(p));
+  }
+  // Columns: each output sensor by each parameter.
+  Result& r = c.result;
+  r.sensitivity_columns = {"t"};
+  r.sensitivity_units = {"s"};
+  for (size_t k = 1; k < r.columns.size(); ++k)
+    for (const SensitivityParameter& p : rs->parameters) {
+      r.sensitivity_columns.push_back("d(" + r.columns[k] + ")/d(" + p.path + ")");
+      r.sensitivity_units.push_back(ratio_unit(r.units[k], p.unit));
+    }
+  r.sensitivities.assign(r.sensitivity_columns.size(), {});
+  rs->last_positions.assign(rs->parameters.size(), std::vector<double>(c.system->nq(), 0.0));
+  return rs;
+}
+
+RunContext* twin_context(RunContext& c, size_t parameter, int side) {
+  if (!c.sensitivities || !c.sensitivities->active) return nullptr;
+  return c.sensitivities->parameters[parameter].twin[side]->context.get();
+}
+
+void sensitivities_failed(RunContext& c, const std::string& status, const std::string& message) {
+  RunSensitivities& rs = *c.sensitivities;
+  if (!rs.active) return;
+  rs.active = false;
+  rs.status = status;
+  rs.message = message;
+  if (c.options.report_failures) std::fprintf(stderr, "mbdae: sensitivities: %s\n", message.c_str());
+}
+
+void follow_static_stage(RunContext& c, int step, json& js) {
+  if (!c.sensitivities || !c.sensitivities->active) return;
+  json out, solved;
+  for (SensitivityParameter& p : c.sensitivities->parameters) {
+    json sides[2], tj[2];
+    for (int side = 0; side < 2; ++side) {
+      RunContext& t = *p.twin[side]->context;
+      if (!analysis_type(t.scene.steps[step].type).stage(t, t.scene.steps[step], tj[side])) {
+        sensitivities_failed(c, "twin_failed",
+                             "the twin at " + p.path + " = " + number_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
+                                 " failed in analysis step " + std::to_string(step) + ": " + t.result.message);
+        return;
+      }
+      sides[side] = sensors_json(*t.system, initial_modes(*t.system, t.q.data(), t.scene.steps[step].t0), t.q.data(),
+                                 t.scene.steps[step].t0);
+    }
+    for (const auto& [name, plus] : sides[0].items())
+      out[name][p.path] = (plus.get<double>() - sides[1][name].get<double>()) / (2 * p.delta);
+    // Force parameters the step solved for (an equilibrium's free length).
+    if (tj[0].contains("parameters"))
+      for (const auto& [name, plus] : tj[0]["parameters"].items())
+        if (plus.is_number() && tj[1]["parameters"].contains(name))
+          solved[name][p.path] = (plus.get<double>() - tj[1]["parameters"][name].get<double>()) / (2 * p.delta);
+  }
+  js["sensitivities"] = out;
+  if (!solved.empty()) js["parameter_sensitivities"] = solved;
+}
+
+void record_sensitivity_sample(RunContext& c, TwinSensitivities& ts, double t, const double* y, const double* yp,
+                               const double* const* s, const double* const* sp, bool project) {
+  RunSensitivities& rs = *c.sensitivities;
+  Result& r = c.result;
+  const size_t rows = r.sensitivities[0].size();
+  if (!rs.active || r.rows() != rows + 1 || r.data[0].back() != t) return;  // the run wrote no row here
+  std::vector<std::vector<double>>& ds = rs.sensor_work;
+  if (!ts.sensors(t, y, yp, s, sp, project, ds)) return sensitivities_failed(c, "output_failed", ts.failure());
+  const size_t np = rs.parameters.size();
+  std::vector<double>& row = rs.row_work;
+  row.resize(r.sensitivity_columns.size());
+  row[0] = t;
+  for (size_t k = 0; k < c.column_sensors.size(); ++k)
+    for (size_t i = 0; i < np; ++i) row[1 + k * np + i] = ds[i][c.column_sensors[k]];
+  if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
+    return sensitivities_failed(c, "not_finite",
+                                r.sensitivity_columns[k] + " is not finite at t = " + number_text(t));
+  for (size_t k = 0; k < row.size(); ++k) r.sensitivities[k].push_back(row[k]);
+  const int nq = c.system->nq();
+  for (size_t i = 0; i < np; ++i) std::copy(s[i], s[i] + nq, rs.last_positions[i].begin());
+}
+
+void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
+  stats["sensitivity_residual_evaluations"] = st.sensitivity_residual_evals;
+  stats["sensitivity_nonlinear_iterations"] = st.sensitivity_nonlinear_iterations;
+  stats["sensitivity_nonlinear_failures"] = st.sensitivity_nonlinear_failures;
+  RunSensitivities& rs = *c.sensitivities;
+  rs.event_times.insert(rs.event_times.end(), st.event_times.begin(), st.event_times.end());
+}
+
+void follow_integration_stage(RunContext& c) {
+  if (!c.sensitivities || !c.sensitivities->active) return;
+  RunSensitivities& rs = *c.sensitivities;
+  for (size_t i = 0; i < rs.parameters.size(); ++i) {
+    SensitivityParameter& p = rs.parameters[i];
+    for (int side = 0; side < 2; ++side) {
+      RunContext& t = *p.twin[side]->context;
+      const double d = side == 0 ? p.delta : -p.delta;
+      for (size_t k = 0; k < c.q.size(); ++k) t.q[k] = c.q[k] + d * rs.last_positions[i][k];
+      t.turns = c.turns;
+    }
+  }
+}
+
+void close_sensitivities(RunContext& c) {
+  if (!c.sensitivities) return;
+  const RunSensitivities& rs = *c.sensitivities;
+  json params = json::array();
+  for (const SensitivityParameter& p : rs.parameters)
+    params.push_back({{"path", p.path}, {"value", p.value}, {"unit", p.unit}, {"difference_step", p.delta}});
+  json columns = json::array();
+  for (size_t k = 0; k < c.result.sensitivity_columns.size(); ++k)
+    columns.push_back({{"name", c.result.sensitivity_columns[k]}, {"unit", c.result.sensitivity_units[k]}});
+  json j;
+  j["method"] = "IDAS forward sensitivities (staggered corrector, sensitivities in the Newton test, not in the error "
+                "test); residual derivatives, consistent initial values and sensors by central differences over "
+                "twin models at p +- d (docs/sensitivities.md)";
+  j["parameters"] = params;
+  j["columns"] = columns;
+  j["rows"] = c.result.sensitivities.empty() ? 0 : c.result.sensitivities[0].size();
+  if (!rs.event_times.empty()) {
+    j["event_times"] = rs.event_times;
+    j["events_note"] = "restarted at each event from the state's sensitivities, made consistent; the event time's own "
+                       "dependence on the parameters is not included: where a force jumps at the event, the "
+                       "sensitivities after it are first-order wrong by the jump times d(t_event)/dp";
+  }
+  j["status"] = rs.status;
+  if (!rs.message.empty()) j["message"] = rs.message;
+  c.result.summary["sensitivities"] = j;
+}
+
+}  // namespace mbdae

@@ -1,0 +1,131 @@
+#include "formulation/twin_sensitivities.h"
+
+#include <stdexcept>
+#include <utility>
+
+#include "formulation/sensors.h"
+
+namespace mbdae {
+
+TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base,
+                                     std::vector<ParameterTwins> twins, bool in_error_test)
+    : run_(run), base_(std::move(base)), twins_(std::move(twins)), in_error_test_(in_error_test) {
+  const int n = run_.size();
+  if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
+  a0_.resize(base_->jacobian_pattern().nnz());
+  a1_.resize(a0_.size());
+  for (const ParameterTwins& p : twins_)
+    if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
+      throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
+  yt_.resize(n);
+  ypt_.resize(n);
+  rp_.resize(n);
+  rm_.resize(n);
+  sp_plus_.resize(run_.system().sensors.size());
+  sp_minus_.resize(run_.system().sensors.size());
+}
+
+void TwinSensitivities::follow(MultibodyDae& twin) {
+  twin.state().modes = run_.state().modes;  // same sizes: no allocation
+  twin.state().turns = run_.state().turns;
+}
+
+void TwinSensitivities::set_segment(double t_start, double t_end) {
+  base_->set_segment(t_start, t_end);
+  for (ParameterTwins& p : twins_) {
+    p.plus->set_segment(t_start, t_end);
+    p.minus->set_segment(t_start, t_end);
+  }
+}
+
+int TwinSensitivities::residual(double t, const double* y, const double* yp, const double*, const double* const* s,
+                                const double* const* sp, double* const* r) {
+  const int n = run_.size();
+  follow(*base_);
+  base_->jacobian(t, 0.0, y, yp, a0_.data());
+  base_->jacobian(t, 1.0, y, yp, a1_.data());
+  const CscPattern& pat = base_->jacobian_pattern();
+  for (size_t i = 0; i < twins_.size(); ++i) {
+    ParameterTwins& p = twins_[i];
+    for (int sign = 1; sign >= -1; sign -= 2) {
+      MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+      follow(twin);
+      const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data());
+      if (flag != 0) return flag;
+    }
+    const double inv = 0.5 / p.delta;
+    for (int k = 0; k < n; ++k) r[i][k] = (rp_[k] - rm_[k]) * inv;
+    for (int c = 0; c < n; ++c) {  // + A0 (s - s') + A1 s', column by column
+      const double d = s[i][c] - sp[i][c], e = sp[i][c];
+      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[i][pat.rowind[k]] += a0_[k] * d + a1_[k] * e;
+    }
+  }
+  return 0;
+}
+
+void TwinSensitivities::initial(double, const double*, const double*, double* const* s, double* const* sp) {
+  const int n = run_.size();
+  for (size_t i = 0; i < twins_.size(); ++i) {
+    const ParameterTwins& p = twins_[i];
+    for (int k = 0; k < n; ++k) {
+      s[i][k] = (p.y_plus[k] - p.y_minus[k]) / (2 * p.delta);
+      sp[i][k] = (p.yp_plus[k] - p.yp_minus[k]) / (2 * p.delta);
+    }
+  }
+}
+
+// Each twin made consistent from y +- d s with the run's modes (not from the switches' signs:
+// at an event the switch is at zero).
+void TwinSensitivities::restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) {
+  const int n = run_.size();
+  std::vector<double> yy[2], yyp[2];
+  for (size_t i = 0; i < twins_.size(); ++i) {
+    ParameterTwins& p = twins_[i];
+    for (int side = 0; side < 2; ++side) {
+      MultibodyDae& twin = side == 0 ? *p.plus : *p.minus;
+      const double d = side == 0 ? p.delta : -p.delta;
+      follow(twin);
+      yy[side].assign(n, 0.0);
+      yyp[side].assign(n, 0.0);
+      for (int k = 0; k < n; ++k) {
+        yy[side][k] = y[k] + d * s[i][k];
+        yyp[side][k] = yp[k] + d * sp[i][k];
+      }
+      twin.consistent_initial_values(t, yy[side], yyp[side]);
+    }
+    for (int k = 0; k < n; ++k) {
+      s[i][k] = (yy[0][k] - yy[1][k]) / (2 * p.delta);
+      sp[i][k] = (yyp[0][k] - yyp[1][k]) / (2 * p.delta);
+    }
+  }
+}
+
+bool TwinSensitivities::sensors(double t, const double* y, const double* yp, const double* const* s,
+                                const double* const* sp, bool project, std::vector<std::vector<double>>& out) {
+  const int n = run_.size();
+  out.resize(twins_.size());
+  for (size_t i = 0; i < twins_.size(); ++i) {
+    ParameterTwins& p = twins_[i];
+    for (int sign = 1; sign >= -1; sign -= 2) {
+      MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+      follow(twin);
+      for (int k = 0; k < n; ++k) {
+        yt_[k] = y[k] + sign * p.delta * s[i][k];
+        if (yp) ypt_[k] = yp[k] + sign * p.delta * sp[i][k];
+      }
+      twin.state().output = run_.state().output;
+      twin.consistent_output(t, yt_.data(), yp ? ypt_.data() : nullptr, qo_, vo_, ao_, project);
+      if (!twin.state().output_failure.empty()) {
+        failure_ = twin.state().output_failure;
+        return false;
+      }
+      evaluate_sensors(twin.system(), twin.state().modes, qo_.data(), vo_.data(), ao_.empty() ? nullptr : ao_.data(),
+                       twin.input_time(t), sign > 0 ? sp_plus_.data() : sp_minus_.data(), nullptr, &twin.state().turns);
+    }
+    out[i].resize(sp_plus_.size());
+    for (size_t k = 0; k < sp_plus_.size(); ++k) out[i][k] = (sp_plus_[k] - sp_minus_[k]) / (2 * p.delta);
+  }
+  return true;
+}
+
+}  // namespace mbdae

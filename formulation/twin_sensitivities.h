@@ -1,0 +1,73 @@
+// Forward sensitivities of a multibody run to scene parameters, for IDAS
+// (core/sensitivity_problem.h), by twins: for each parameter p_i two copies of the run's
+// formulation, built on the model with p_i + d_i and p_i - d_i (their own Systems, with the
+// same coordinates and equations), whose modes and turns follow the run's. The sensitivity
+// equations' residual is
+//
+//   F_y s + F_y' s' + F_p  =  A0 (s - s') + A1 s'  +  [F+(y, y') - F-(y, y')] / (2 d),
+//
+// A0 = F_y and A1 = F_y + F_y' the formulation's own Newton matrix at cj = 0 and cj = 1 (exact,
+// on a copy of the run's DAE, once per call for all parameters), and F_p a central difference
+// over the twins at the same (y, y'): the terms that do not depend on p are evaluated bit for
+// bit alike in both twins and cancel, so its rounding is that of the terms p enters, and no
+// parameter needs code of its own (force parameters, masses, hardpoints, gravity, expression
+// constants alike). (A difference of F+- at y +- d s, tried first, mixes the rounding of every
+// term, eps |y| / d, into s: 1e5 times the rounding, more than index3's position tolerances
+// allow the Newton test; the run failed at its first steps.) Consistent (s, s') at a restart
+// and the sensors' sensitivities at a sample are central differences of the twins' own
+// consistent values and sensors at y +- d s.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/sensitivity_problem.h"
+#include "formulation/multibody_dae.h"
+
+namespace mbdae {
+
+struct ParameterTwins {
+  std::unique_ptr<MultibodyDae> plus, minus;  // the formulation on the model at p + d, p - d
+  double delta = 0;  // d, in the parameter's units
+  double scale = 1;  // a typical magnitude of the parameter (IDAS's pbar)
+  // Each twin's consistent initial (y, y') from its own chain of analyses.
+  std::vector<double> y_plus, yp_plus, y_minus, yp_minus;
+};
+
+class TwinSensitivities : public SensitivityProblem {
+ public:
+  // `run` is the formulation being integrated; the twins must have its size.
+  // `base` is another copy of the run's formulation on the run's own model (its Newton matrix).
+  TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base, std::vector<ParameterTwins> twins,
+                    bool in_error_test);
+
+  int count() const override { return static_cast<int>(twins_.size()); }
+  double scale(int i) const override { return twins_[i].scale; }
+  int residual(double t, const double* y, const double* yp, const double* residual, const double* const* s,
+               const double* const* sp, double* const* r) override;
+  void initial(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
+  void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
+  void set_segment(double t_start, double t_end) override;
+  bool in_error_test() const override { return in_error_test_; }
+
+  // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' consistent
+  // output (projected when `project`) and sensors at y +- d s_i. False, with `failure` set,
+  // when a twin's output state cannot be formed.
+  bool sensors(double t, const double* y, const double* yp, const double* const* s, const double* const* sp,
+               bool project, std::vector<std::vector<double>>& out);
+  const std::string& failure() const { return failure_; }
+  const ParameterTwins& twins(int i) const { return twins_[i]; }
+
+ private:
+  void follow(MultibodyDae& twin);  // the run's modes and turns
+  MultibodyDae& run_;
+  std::unique_ptr<MultibodyDae> base_;
+  std::vector<double> a0_, a1_;  // the Newton matrix's values at cj = 0 and 1
+  std::vector<ParameterTwins> twins_;
+  bool in_error_test_;
+  std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
+  std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
+  std::string failure_;
+};
+
+}  // namespace mbdae
