@@ -13,7 +13,7 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
   a0_.resize(base_->jacobian_pattern().nnz());
-  a1_.resize(a0_.size());
+  r0_.resize(n);
   for (const ParameterTwins& p : twins_)
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
       throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
@@ -43,10 +43,13 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
   const int n = run_.size();
   follow(*base_);
   base_->jacobian(t, 0.0, y, yp, a0_.data());
-  base_->jacobian(t, 1.0, y, yp, a1_.data());
+  if (const int flag = base_->residual(t, y, yp, r0_.data()); flag != 0) return flag;
   const CscPattern& pat = base_->jacobian_pattern();
   for (size_t i = 0; i < twins_.size(); ++i) {
     ParameterTwins& p = twins_[i];
+    for (int k = 0; k < n; ++k) ypt_[k] = yp[k] + p.scale * sp[i][k];  // F_y' s' (F affine in y')
+    if (const int flag = base_->residual(t, y, ypt_.data(), r[i]); flag != 0) return flag;
+    for (int k = 0; k < n; ++k) r[i][k] = (r[i][k] - r0_[k]) / p.scale;
     for (int sign = 1; sign >= -1; sign -= 2) {
       MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
       follow(twin);
@@ -54,11 +57,9 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
       if (flag != 0) return flag;
     }
     const double inv = 0.5 / p.delta;
-    for (int k = 0; k < n; ++k) r[i][k] = (rp_[k] - rm_[k]) * inv;
-    for (int c = 0; c < n; ++c) {  // + A0 (s - s') + A1 s', column by column
-      const double d = s[i][c] - sp[i][c], e = sp[i][c];
-      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[i][pat.rowind[k]] += a0_[k] * d + a1_[k] * e;
-    }
+    for (int k = 0; k < n; ++k) r[i][k] += (rp_[k] - rm_[k]) * inv;
+    for (int c = 0; c < n; ++c)  // + A0 s, column by column
+      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[i][pat.rowind[k]] += a0_[k] * s[i][c];
   }
   return 0;
 }

@@ -4,11 +4,13 @@
 // same coordinates and equations), whose modes and turns follow the run's. The sensitivity
 // equations' residual is
 //
-//   F_y s + F_y' s' + F_p  =  A0 (s - s') + A1 s'  +  [F+(y, y') - F-(y, y')] / (2 d),
+//   F_y s + F_y' s' + F_p  =  A0 s  +  [F(y, y' + b s') - F(y, y')] / b  +  [F+(y, y') - F-(y, y')] / (2 d),
 //
-// A0 = F_y and A1 = F_y + F_y' the formulation's own Newton matrix at cj = 0 and cj = 1 (exact,
-// on a copy of the run's DAE, once per call for all parameters), and F_p a central difference
-// over the twins at the same (y, y'): the terms that do not depend on p are evaluated bit for
+// A0 = F_y the formulation's own Newton matrix at cj = 0 (exact, on a copy of the run's DAE,
+// once per call for all parameters); F_y' s' exact to rounding by a difference in y' alone,
+// every formulation's F being affine in y' (b the parameter's scale, so that b s' is a change of
+// y' in its own units; tested against the Newton matrix at cj = 1 minus A0); and F_p a central
+// difference over the twins at the same (y, y'): the terms that do not depend on p are evaluated bit for
 // bit alike in both twins and cancel, so its rounding is that of the terms p enters, and no
 // parameter needs code of its own (force parameters, masses, hardpoints, gravity, expression
 // constants alike). (A difference of F+- at y +- d s, tried first, mixes the rounding of every
@@ -62,10 +64,10 @@ class TwinSensitivities : public SensitivityProblem {
   void follow(MultibodyDae& twin);  // the run's modes and turns
   MultibodyDae& run_;
   std::unique_ptr<MultibodyDae> base_;
-  std::vector<double> a0_, a1_;  // the Newton matrix's values at cj = 0 and 1
+  std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
-  std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
+  std::vector<double> yt_, ypt_, rp_, rm_, r0_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
   std::string failure_;
 };

@@ -41,7 +41,8 @@ struct PyRunOptions : mbdae::RunOptions {
 // folder is touched (a refused scene leaves it as it was).
 mbdae::Result run_with_sinks(const mbdae::Scene& scene, const PyRunOptions& options) {
   if (!options.out_dir.empty() || !options.animation_dir.empty()) mbdae::check_runnable(scene, options);
-  const mbdae::OutputRequest request{options.out_dir, options.animation_dir, options.animation_rate};
+  const mbdae::OutputRequest request{options.out_dir, options.animation_dir, options.animation_rate,
+                                     !options.sensitivities.empty()};
   mbdae::RunSinks out = mbdae::open_sinks(scene, request);
   int tries = 0;
   const mbdae::SinkFactory make_sinks = [&] {
@@ -148,6 +149,7 @@ void bind_run(py::module_& m) {
       .def_readwrite("atol", &mbdae::RunOptions::atol)
       .def_readwrite("output_step", &mbdae::RunOptions::output_step)
       .def_readwrite("formulation", &mbdae::RunOptions::formulation)
+      .def_readwrite("sensitivities", &mbdae::RunOptions::sensitivities)
       .def_readwrite("analysis", &mbdae::RunOptions::analysis)
       .def_readwrite("verbose", &mbdae::RunOptions::verbose)
       .def_readwrite("progress", &mbdae::RunOptions::progress)
@@ -174,7 +176,13 @@ void bind_run(py::module_& m) {
       .def_readonly("q", &mbdae::Result::q)
       .def_property_readonly("rows", &mbdae::Result::rows)
       .def_property_readonly("summary_json", [](const mbdae::Result& r) { return r.summary.dump(); })
-      .def("column", [](py::object self, size_t k) { return column_view(self, self.cast<const mbdae::Result&>(), k); });
+      .def("column", [](py::object self, size_t k) { return column_view(self, self.cast<const mbdae::Result&>(), k); })
+      .def_readonly("sensitivity_names", &mbdae::Result::sensitivity_columns)
+      .def_readonly("sensitivity_units", &mbdae::Result::sensitivity_units)
+      .def("sensitivity_column", [](const mbdae::Result& r, size_t k) {
+        if (k >= r.sensitivities.size()) throw py::index_error("sensitivity column index out of range");
+        return py::array_t<double>(r.sensitivities[k].size(), r.sensitivities[k].data());  // a copy
+      });
   m.def("run", &run_released, py::arg("scene"), py::arg("options"));
   m.def("option_errors", [](const mbdae::Scene& scene, const PyRunOptions& options) {
     return mbdae::run_option_errors(scene, options);

@@ -40,8 +40,8 @@ std::string number_text(double v) {
 // "m/(N/m)": a sensitivity's unit from the sensor's and the parameter's.
 std::string ratio_unit(const std::string& y, const std::string& p) {
   if (p.empty() || p == "1") return y;
-  const bool compound = p.find_first_of("/ *^") != std::string::npos;
-  return (y.empty() ? "1" : y) + "/" + (compound ? "(" + p + ")" : p);
+  auto group = [](const std::string& u) { return u.find_first_of("/ *") != std::string::npos ? "(" + u + ")" : u; };
+  return (y.empty() ? "1" : group(y)) + "/" + group(p);
 }
 
 std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParameter& p, double value) {
@@ -233,9 +233,9 @@ void close_sensitivities(RunContext& c) {
   j["rows"] = c.result.sensitivities.empty() ? 0 : c.result.sensitivities[0].size();
   if (!rs.event_times.empty()) {
     j["event_times"] = rs.event_times;
-    j["events_note"] = "restarted at each event from the state's sensitivities, made consistent; the event time's own "
-                       "dependence on the parameters is not included: where a force jumps at the event, the "
-                       "sensitivities after it are first-order wrong by the jump times d(t_event)/dp";
+    j["events_note"] = "restarted at each event from the state's sensitivities, made consistent with the new modes; "
+                       "the jump (y'- - y'+) dt_event/dp is zero because every switching force (wheel_contact) is "
+                       "continuous at its switch (docs/sensitivities.md)";
   }
   j["status"] = rs.status;
   if (!rs.message.empty()) j["message"] = rs.message;

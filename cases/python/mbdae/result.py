@@ -10,8 +10,11 @@ class Result:
     sensors) to a read-only numpy array; `table` is a pandas DataFrame of the same; `summary` is
     the content of summary.json as a dict; `status` is "ok" or the failure."""
 
-    def __init__(self, status, message, names, arrays, units, summary_json, q=()):
+    def __init__(self, status, message, names, arrays, units, summary_json, q=(), sensitivity=((), (), ())):
         self.status = status
+        # Scene.run(sensitivities=[...]): column names ("t", then "d(SENSOR)/d(PATH)"), units, arrays.
+        self._sens_names, self._sens_units, self._sens_arrays = (list(x) for x in sensitivity)
+        self._sens_table = None
         self.message = message
         self.names = list(names)
         self.units = list(units)
@@ -24,8 +27,10 @@ class Result:
     @classmethod
     def _from_core(cls, r):
         # r.column(k) is a numpy view over the C++ vector and holds r alive.
+        names = list(r.sensitivity_names)
+        sensitivity = (names, list(r.sensitivity_units), [r.sensitivity_column(k) for k in range(len(names))])
         return cls(r.status, r.message, r.names, [r.column(k) for k in range(len(r.names))], r.units,
-                   r.summary_json, r.q)
+                   r.summary_json, r.q, sensitivity)
 
     @property
     def ok(self):
@@ -61,6 +66,29 @@ class Result:
             self._summary = json.loads(self._summary_json) if self._summary_json else {}
         return self._summary
 
+    @property
+    def sensitivities(self):
+        """Scene.run(sensitivities=[paths]): a pandas DataFrame indexed by `t` with one column per
+        (sensor, parameter) pair, d(sensor)/d(parameter) in the units of
+        `sensitivity_units[(sensor, parameter)]` (docs/sensitivities.md); None without them. Fewer
+        rows than `table` where they failed (summary["sensitivities"]["status"])."""
+        if not self._sens_names:
+            return None
+        if self._sens_table is None:
+            import pandas as pd
+            params = [p["path"] for p in self.summary.get("sensitivities", {}).get("parameters", [])]
+            sensors = self.names[1:]
+            index = pd.MultiIndex.from_tuples([(s, p) for s in sensors for p in params], names=["sensor", "parameter"])
+            data = np.column_stack(self._sens_arrays[1:]) if len(self._sens_arrays) > 1 else np.empty((0, 0))
+            self._sens_table = pd.DataFrame(data, index=pd.Index(self._sens_arrays[0], name="t"), columns=index)
+        return self._sens_table
+
+    @property
+    def sensitivity_units(self):
+        """{(sensor, parameter): unit} of the sensitivities' columns ("m/(N/m)", ...)."""
+        table = self.sensitivities
+        return {} if table is None else dict(zip(table.columns, self._sens_units[1:]))
+
     def cpu_seconds(self):
         """The integration steps' CPU time (sum of the steps' statistics.cpu_seconds): the clock of
         the thread that solved them, so runs in parallel threads each report their own cost."""
@@ -82,7 +110,8 @@ class Result:
 
     def __reduce__(self):  # pickles as plain arrays (Dask, multiprocessing)
         return (Result, (self.status, self.message, self.names, [np.array(a) for a in self._arrays], self.units,
-                         self._summary_json, self.q))
+                         self._summary_json, self.q,
+                         (self._sens_names, self._sens_units, [np.array(a) for a in self._sens_arrays])))
 
     # ---- Writers over the result ------------------------------------------------------------
     animation_dir = None  # set by Scene.run(animation=...)

@@ -120,7 +120,7 @@ class Scene:
 
     def run(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, out=None,
             raise_on_failure=True, animation=None, animation_rate=None, error_estimate=None, error_target=None,
-            error_sensors=None, error_warnings=True):
+            error_sensors=None, error_warnings=True, sensitivities=None):
         """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
         override the scene's when given; `analysis` (an index or a step type such as "dynamics")
         stops after that step; `out` also writes results.csv and summary.json there. `animation`
@@ -132,7 +132,9 @@ class Scene:
         `error_target=E` picks rtol and atol so that the estimated error of `error_sensors` (a list
         of names; default every output sensor, E then relative to each one's scale) is at most E
         (summary["error_target"]; status "accuracy_not_met" when it cannot); error_warnings=False
-        keeps the estimate's warnings (over 10 rtol) off stderr. Returns a Result; a failed
+        keeps the estimate's warnings (over 10 rtol) off stderr. `sensitivities` (a parameter path
+        or a list of them, as `set` takes them) also integrates d(sensor)/d(parameter) of every
+        output sensor (Result.sensitivities, docs/sensitivities.md). Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis)
@@ -151,6 +153,8 @@ class Scene:
             if not isinstance(error_warnings, bool):
                 raise ValueError(f"error_warnings expects True or False, got {error_warnings!r}")
             opt.error_warnings = error_warnings
+            if sensitivities is not None:
+                opt.sensitivities = _paths("sensitivities", sensitivities)
             result = Result._from_core(_scene_errors(_core.run, self._core, opt))
         except BaseException:
             if temporary:
@@ -236,6 +240,19 @@ def _rebuild(path, text, overrides):
     if not overrides:
         return scene
     return Scene(_scene_errors(_core.with_parameters, scene._core, list(overrides)), path, text, overrides)
+
+
+def _paths(name, value):
+    """A parameter path or a list of them, as strings (ValueError otherwise)."""
+    items = [value] if isinstance(value, str) else value
+    try:
+        items = list(items)
+    except TypeError:
+        raise ValueError(f"{name} expects a parameter path or a list of them, got {value!r}") from None
+    for p in items:
+        if not isinstance(p, str) or not p:
+            raise ValueError(f"{name} expects parameter paths (non-empty strings), got {p!r}")
+    return items
 
 
 def _number(name, value):
