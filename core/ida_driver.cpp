@@ -40,9 +40,36 @@ struct UserData {
   int non_finite = -1;         // a component of y found not finite by weights_fn
   double non_finite_value = 0;
   SensitivityProblem* sens = nullptr;  // IdaOptions::sensitivities
+  N_Vector state_weights = nullptr;    // the state's weight vector (IDA's first weights_fn call)
+  const double* id = nullptr;          // the error test's mask
+  double state_size = 0;               // max |y_i| over the error-tested components, at the last state weights
   std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
   std::vector<double*> r_out;
 };
+
+// With sensitivities, IDAS calls weights_fn for the state (first, and always with the same
+// weight vector) and for each sensitivity at pbar_i s_i. The sensitivities' tolerances never go
+// below kSensitivityNoise times the state's size: their residual's parameter derivative is a
+// difference over twin models (formulation/twin_sensitivities.h) whose rounding is about 1e5 eps
+// of the state, above the rounding-level floors of the state's own weights (measured: index2-ggl
+// on A01 at rtol 1e-8 stopped at its first step without this floor).
+constexpr double kSensitivityNoise = 1e-9;
+
+void sensitivity_weight_floor(UserData* u, N_Vector y, N_Vector w) {
+  const int n = u->problem->size();
+  if (!u->state_weights) u->state_weights = w;
+  double* wd = N_VGetArrayPointer(w);
+  if (w == u->state_weights) {
+    const double* yd = N_VGetArrayPointer(y);
+    u->state_size = 0;
+    for (int i = 0; i < n; ++i)
+      if (u->id[i] > 0) u->state_size = std::fmax(u->state_size, std::fabs(yd[i]));
+    return;
+  }
+  const double floor = kSensitivityNoise * u->state_size;
+  for (int i = 0; i < n; ++i)
+    if (floor > 0 && wd[i] * floor > 1) wd[i] = 1 / floor;
+}
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
   auto* u = static_cast<UserData*>(ud);
@@ -66,6 +93,7 @@ int weights_fn(N_Vector y, N_Vector w, void* ud) {
   // tried (with 0.1, a kinematic sweep at rtol 1e-8 collapsed to h = 1e-12 after one failure:
   // the stale, too strict velocity and multiplier tolerances made every retry fail).
   u->problem->error_weights(1e-3 * h, N_VGetArrayPointer(y), u->rtol, u->atol, N_VGetArrayPointer(w));
+  if (u->sens) sensitivity_weight_floor(u, y, w);
   return 0;
 }
 
@@ -297,6 +325,7 @@ void open_sensitivities(IdaRun& r) {
   r.ss_data = data(r.ss, r.ns);
   r.sps_data = data(r.sps, r.ns);
   r.ud.sens = sp;
+  r.ud.id = data(r.id);
   r.ud.s_in.resize(r.ns);
   r.ud.sp_in.resize(r.ns);
   r.ud.r_out.resize(r.ns);

@@ -62,6 +62,7 @@ class TwinSensitivities : public SensitivityProblem {
 
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
+
   MultibodyDae& run_;
   std::unique_ptr<MultibodyDae> base_;
   std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y

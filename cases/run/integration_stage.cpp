@@ -263,7 +263,7 @@ std::unique_ptr<TwinSensitivities> twin_sensitivities(RunContext& c, const Analy
     }
     twins.push_back(std::move(pt));
   }
-  return std::make_unique<TwinSensitivities>(dae, make_dae(*c.system, f, fp, tol), std::move(twins), false);
+  return std::make_unique<TwinSensitivities>(dae, make_dae(*c.system, f, fp, tol), std::move(twins), true);
 }
 
 json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
@@ -314,7 +314,13 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
 bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
   js["type"] = analysis_type(step.type).name;
-  const std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+  std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+  if (c.sensitivities && c.sensitivities->active && !sensitivity_formulation(name)) {
+    // The scene's index3 (a formulation asked by name is refused before the run): the step runs
+    // as index2-ggl, and says so (docs/sensitivities.md).
+    js["formulation_with_sensitivities"] = "index2-ggl instead of the scene's " + name + ": " + kIndex3SensitivityNote;
+    name = "index2-ggl";
+  }
   const Formulation* f = find_formulation(name);
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");

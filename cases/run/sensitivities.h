@@ -53,6 +53,11 @@ struct RunSensitivities {
 // to rounding; 1e-5 (near eps^(1/3)) balances the two (docs/sensitivities.md).
 constexpr double kRelativeStep = 1e-5;
 
+// Whether a formulation's sensitivities can be integrated: not index3's (index3-positions'):
+// kIndex3SensitivityNote says why.
+bool sensitivity_formulation(const std::string& formulation);
+extern const char* const kIndex3SensitivityNote;
+
 // Problems with the requested paths, each message starting with `option`: an unknown path (with
 // a "did you mean"), a path that names no single number, an analysis setting (rtol, t_end, ...:
 // not a parameter of the model), a path asked twice.

@@ -1,0 +1,221 @@
+// Sensitivities (RunOptions::sensitivities, docs/sensitivities.md) against closed forms, through
+// the public API and the executable: a damped oscillator's position and velocity against its
+// stiffness, damping, mass and initial position for every formulation; the IFToMM A01 pendulum
+// against its length (Jacobi's exact solution); bad requests refused before any run, the files
+// and summary entries of `mbdae run --sensitivity`.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/mbdae.h"
+#include "cases/tests/run_command.h"
+#include "core/errors.h"
+#include "verification/iftomm/pendulum_exact.h"
+
+namespace mbdae {
+namespace {
+
+using test_support::read_file;
+using test_support::run_command;
+
+// A slider (mass m) on a prismatic joint along z, pushed by fz = -K z - C vz, released at z0.
+std::string oscillator(const std::string& formulation) {
+  return R"(name: oscillator
+gravity: [0, 0, 0]
+bodies:
+  - {name: slider, mass: 2.0, inertia: {xx: 0.1, yy: 0.1, zz: 0.1}}
+joints:
+  - {name: rail, parent: ground, child: slider, anchor: [0, 0, 0], chain: [T3], coordinates: [s]}
+coordinates:
+  s: {initial: 0.2}
+forces:
+  - {name: push, type: point_force, body: slider, point: com, fz: "-K * z - C * vz", parameters: {K: 50, C: 2}}
+sensors:
+  - {name: z, type: position, body: slider, point: [0, 0, 0], component: z}
+  - {name: vz, type: velocity, body: slider, component: z}
+analysis:
+  - {type: assembly, hold: [s]}
+  - {type: dynamics, t_end: 4, output_step: 0.05, rtol: 1.0e-10, formulation: )" +
+         formulation + "}\n";
+}
+
+// The oscillator's closed form: z(t) and vz(t) for stiffness K, damping C, mass m, start z0.
+struct Oscillator {
+  double K = 50, C = 2, m = 2, z0 = 0.2;
+  void at(double t, double& z, double& v) const {
+    const double w = std::sqrt(K / m), zeta = C / (2 * std::sqrt(K * m)), wd = w * std::sqrt(1 - zeta * zeta);
+    const double e = std::exp(-zeta * w * t);
+    z = z0 * e * (std::cos(wd * t) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * t));
+    v = -z0 * w / std::sqrt(1 - zeta * zeta) * e * std::sin(wd * t);
+  }
+};
+
+// d(sensor)/d(parameter) of a closed form by central differences (step 1e-6 relative: exact to
+// about 1e-10 of the derivative).
+double closed_form_derivative(const std::function<double(double)>& f, double p) {
+  const double h = 1e-6 * std::fabs(p);
+  return (f(p + h) - f(p - h)) / (2 * h);
+}
+
+// The largest |computed - reference| of a column over the samples, relative to the reference's
+// largest magnitude.
+double relative_error(const Result& r, const std::string& column, const std::function<double(double)>& reference) {
+  const int k = static_cast<int>(std::find(r.sensitivity_columns.begin(), r.sensitivity_columns.end(), column) -
+                                 r.sensitivity_columns.begin());
+  EXPECT_LT(k, static_cast<int>(r.sensitivity_columns.size())) << column;
+  if (k >= static_cast<int>(r.sensitivity_columns.size())) return 1e300;
+  double worst = 0, scale = 0;
+  const auto& t = r.sensitivities[0];
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double ref = reference(t[i]);
+    worst = std::max(worst, std::fabs(r.sensitivities[k][i] - ref));
+    scale = std::max(scale, std::fabs(ref));
+  }
+  return worst / scale;
+}
+
+TEST(Sensitivities, DampedOscillatorMatchesItsClosedFormInEveryFormulation) {
+  const char* paths[] = {"forces.push.parameters.K", "forces.push.parameters.C", "bodies.slider.mass",
+                         "coordinates.s.initial"};
+  for (const char* form : {"index3", "index2-ggl", "index1", "penalty"}) {
+    SCOPED_TRACE(form);
+    RunOptions opt;
+    opt.sensitivities.assign(std::begin(paths), std::end(paths));
+    const Result r = run(load_scene_text(oscillator(form), "oscillator.yaml"), opt);
+    ASSERT_TRUE(r.ok()) << r.message;
+    ASSERT_EQ(r.sensitivities[0].size(), r.rows());
+    EXPECT_EQ(r.summary["sensitivities"]["status"], "ok");
+    // The scene's index3 runs as index2-ggl with sensitivities, and says so.
+    const auto& step = r.summary["steps"].back();
+    EXPECT_EQ(step["formulation"], std::string(form) == "index3" ? "index2-ggl" : form);
+    EXPECT_EQ(step.contains("formulation_with_sensitivities"), std::string(form) == "index3");
+    for (int which = 0; which < 4; ++which) {
+      for (int sensor = 0; sensor < 2; ++sensor) {
+        auto reference = [&](double t) {
+          Oscillator o;
+          double* p[] = {&o.K, &o.C, &o.m, &o.z0};
+          return closed_form_derivative([&](double value) {
+            Oscillator x = o;
+            double* q[] = {&x.K, &x.C, &x.m, &x.z0};
+            *q[which] = value;
+            double z, v;
+            x.at(t, z, v);
+            return sensor == 0 ? z : v;
+          }, *p[which]);
+        };
+        const std::string column = std::string("d(") + (sensor == 0 ? "z" : "vz") + ")/d(" + paths[which] + ")";
+        // Measured: 2e-9 to 3e-7 of the largest sensitivity (penalty: its constraint bias).
+        EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
+      }
+    }
+  }
+}
+
+// A01 (verification/iftomm/scenes/A01_simple_pendulum.yaml) over 10 s with the bob's position
+// sensed at the centre of mass, so that its length is the one number bodies.link.com.0.
+TEST(Sensitivities, PendulumBobAgainstItsLengthMatchesJacobisSolution) {
+  const std::string text = R"(name: A01
+gravity: [0, -9.81, 0]
+bodies:
+  - {name: link, mass: 1.0, com: [1, 0, 0], inertia: {xx: 0, yy: 0, zz: 0}}
+joints:
+  - {name: pivot, parent: ground, child: link, anchor: [0, 0, 0], chain: [R3], coordinates: [phi]}
+coordinates:
+  phi: {initial: 0}
+sensors:
+  - {name: x, type: position, body: link, point: com, component: x}
+  - {name: y, type: position, body: link, point: com, component: y}
+analysis:
+  - {type: dynamics, t_end: 10, output_step: 0.05, rtol: 1.0e-10}
+)";
+  RunOptions opt;
+  opt.sensitivities = {"bodies.link.com.0"};
+  const Result r = run(load_scene_text(text, "a01.yaml"), opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  for (int sensor = 0; sensor < 2; ++sensor) {
+    auto reference = [&](double t) {
+      return closed_form_derivative([&](double length) {
+        PendulumExact p;
+        p.length = length;
+        p.w0 = std::sqrt(9.81 / length);
+        return sensor == 0 ? p.x(t) : p.y(t);
+      }, 1.0);
+    };
+    const std::string column = std::string("d(") + (sensor == 0 ? "x" : "y") + ")/d(bodies.link.com.0)";
+    EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
+  }
+}
+
+TEST(Sensitivities, BadRequestsAreRefusedBeforeTheRun) {
+  const Scene scene = load_scene_text(oscillator("index3"), "oscillator.yaml");
+  const struct {
+    const char* path;
+    const char* message;
+  } cases[] = {
+      {"forces.push.parameters.k", "no such parameter (`mbdae params SCENE` lists them); did you mean 'forces.push.parameters.K'?"},
+      {"gravity", "not a single number; name one element: gravity.0"},
+      {"analysis.dynamics.rtol", "a setting of the analysis, not a parameter of the model"},
+      {"forces.push.fz", "not a single number"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.path);
+    RunOptions opt;
+    opt.sensitivities = {c.path};
+    try {
+      run(scene, opt);
+      ADD_FAILURE() << "no error";
+    } catch (const ModelError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
+    }
+  }
+  RunOptions twice;
+  twice.sensitivities = {"bodies.slider.mass", "bodies.slider.mass"};
+  EXPECT_THROW(run(scene, twice), ModelError);
+}
+
+class SensitivitiesCli : public test_support::RunFolderTest {
+ protected:
+  SensitivitiesCli() : RunFolderTest("mbdae_sens_") {}
+};
+
+TEST_F(SensitivitiesCli, WritesTheCsvAndListsTheParametersInTheSummary) {
+  {
+    std::ofstream(dir / "s.yaml") << oscillator("index3");
+  }
+  const std::string base = std::string(MBDAE_EXE) + " run " + (dir / "s.yaml").string() + " --out " + out.string() + " --quiet";
+  auto r = run_command(base + " --sensitivity bodies.slider.mass --sensitivity forces.push.parameters.K");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string csv = read_file(out / "sensitivities.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "t,d(z)/d(bodies.slider.mass),d(z)/d(forces.push.parameters.K),d(vz)/d(bodies.slider.mass),"
+            "d(vz)/d(forces.push.parameters.K)");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 82);  // header and 81 samples, as results.csv
+  const auto summary = nlohmann::json::parse(read_file(out / "summary.json"));
+  const auto& s = summary["sensitivities"];
+  EXPECT_EQ(s["status"], "ok");
+  EXPECT_EQ(s["parameters"][0]["path"], "bodies.slider.mass");
+  EXPECT_EQ(s["parameters"][0]["unit"], "kg");
+  EXPECT_EQ(s["parameters"][0]["value"], 2.0);
+  EXPECT_EQ(s["columns"][1]["unit"], "m/kg");
+  EXPECT_EQ(s["columns"][3]["unit"], "(m/s)/kg");
+  // A run without sensitivities into the same folder leaves no stale file.
+  r = run_command(base);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "sensitivities.csv"));
+  // Bad requests: usage errors (exit 1) before the folder is touched.
+  for (const std::string& bad : {std::string(" --sensitivity"), std::string(" --sensitivity bodies.slider.mas"),
+                                 std::string(" --sensitivity analysis.dynamics.t_end"),
+                                 std::string(" --sensitivity bodies.slider.mass --formulation index3")}) {
+    r = run_command(base + bad);
+    EXPECT_EQ(r.code, 1) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("--sensitivity"), std::string::npos) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace mbdae
