@@ -1,0 +1,143 @@
+// The suspension's sensitivities (docs/sensitivities.md) against central finite differences of
+// tight runs, the difference step stated per parameter: the kinematic sweep's toe and camber
+// against three hardpoint coordinates, the equilibrium's free length against the spring
+// stiffness (also in closed form), Dynamics I's wheel against the tyre stiffness, the suspension
+// damping and the wheel mass before the ground step and after the contact events. Each test
+// prints what it measured (the figures of docs/sensitivities.md).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cases/mbdae.h"
+
+namespace mbdae {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+Scene scene(const std::string& name) {
+  return load_scene(std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/" + name);
+}
+
+std::string text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+const std::vector<double>& sensitivity(const Result& r, const std::string& sensor, const std::string& path) {
+  const std::string name = "d(" + sensor + ")/d(" + path + ")";
+  const auto it = std::find(r.sensitivity_columns.begin(), r.sensitivity_columns.end(), name);
+  if (it == r.sensitivity_columns.end()) throw std::runtime_error("no column " + name);
+  return r.sensitivities[it - r.sensitivity_columns.begin()];
+}
+
+// The central difference of `sensor` between runs at value +- h (same options).
+std::vector<double> central_difference(const Scene& s, const std::string& path, double value, double h,
+                                       const std::string& sensor, const RunOptions& opt) {
+  const Result plus = run(with_parameters(s, {{path, text(value + h)}}), opt);
+  const Result minus = run(with_parameters(s, {{path, text(value - h)}}), opt);
+  EXPECT_TRUE(plus.ok() && minus.ok()) << plus.message << minus.message;
+  const auto& a = plus.column(sensor);
+  const auto& b = minus.column(sensor);
+  std::vector<double> d(std::min(a.size(), b.size()));
+  for (size_t i = 0; i < d.size(); ++i) d[i] = (a[i] - b[i]) / (2 * h);
+  return d;
+}
+
+// max |computed - reference| over the samples with t in [t0, t1), relative to the reference's
+// largest magnitude over the whole run.
+double relative_error(const std::vector<double>& t, const std::vector<double>& computed, const std::vector<double>& ref,
+                      double t0 = -1e300, double t1 = 1e300) {
+  double worst = 0, scale = 0;
+  for (size_t i = 0; i < ref.size() && i < computed.size(); ++i) {
+    scale = std::max(scale, std::fabs(ref[i]));
+    if (t[i] >= t0 && t[i] < t1) worst = std::max(worst, std::fabs(computed[i] - ref[i]));
+  }
+  return worst / scale;
+}
+
+TEST(SuspensionSensitivities, KinematicToeAndCamberAgainstThreeHardpoints) {
+  const Scene s = scene("kinematics.yaml");
+  const std::vector<std::pair<std::string, double>> points = {
+      {"bodies.chassis.points.bp1.2", 0.327}, {"bodies.chassis.points.bp3.0", -0.093}, {"bodies.chassis.points.bp5.1", 0.3845}};
+  RunOptions opt;
+  for (const auto& p : points) opt.sensitivities.push_back(p.first);
+  const Result r = run(s, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  RunOptions plain;
+  for (const auto& [path, value] : points) {
+    for (const char* sensor : {"toe", "camber"}) {
+      const double h = 1e-5;  // [m]; the scene's rtol 1e-11 runs
+      const auto fd = central_difference(s, path, value, h, sensor, plain);
+      const double e = relative_error(r.column("t"), sensitivity(r, sensor, path), fd);
+      std::printf("measured: kinematics d(%s)/d(%s): %.2e of the largest\n", sensor, path.c_str(), e);
+      EXPECT_LT(e, 1e-4) << sensor << " " << path;
+    }
+  }
+}
+
+TEST(SuspensionSensitivities, EquilibriumFreeLengthAgainstTheSpringStiffness) {
+  const Scene s = scene("equilibrium.yaml");
+  RunOptions opt;
+  opt.sensitivities = {"forces.suspension.stiffness"};
+  const Result r = run(s, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  const json& eq = r.summary["steps"][1];
+  const double z0 = eq["parameters"]["suspension.free_length"].get<double>();
+  const double length = eq["sensors"]["spring_length"].get<double>();
+  const double k = 1.4e5;
+  const double dz0 = eq["parameter_sensitivities"]["suspension.free_length"]["forces.suspension.stiffness"].get<double>();
+  // The held configuration fixes the spring's force F = k (Z0 - L): dZ0/dk = -(Z0 - L) / k.
+  EXPECT_NEAR(dz0, -(z0 - length) / k, 1e-8 * std::fabs(dz0));
+  // And against central differences of the equilibrium (h = 1 N/m).
+  double zp = 0, zm = 0;
+  for (int side = 0; side < 2; ++side) {
+    const Result x = run(with_parameters(s, {{"forces.suspension.stiffness", text(k + (side == 0 ? 1 : -1))}}), RunOptions{});
+    (side == 0 ? zp : zm) = x.summary["steps"][1]["parameters"]["suspension.free_length"].get<double>();
+  }
+  std::printf("measured: equilibrium dZ0/dk %.10e, closed form %.10e, central difference %.10e\n", dz0,
+              -(z0 - length) / k, (zp - zm) / 2);
+  EXPECT_NEAR(dz0, (zp - zm) / 2, 1e-6 * std::fabs(dz0));
+}
+
+// Dynamics I at rtol 1e-10 against central differences of rtol 1e-11 runs (relative step 1e-4,
+// index2-ggl like the sensitivities' run): before the ground step (t < 0.2 s), from it to the
+// first lift-off (0.236 s) and after the contact events.
+TEST(SuspensionSensitivities, DynamicsIWheelAgainstTyreDampingAndMass) {
+  const Scene s = scene("dynamics_step.yaml");
+  const std::vector<std::pair<std::string, double>> params = {
+      {"forces.tyre.stiffness", 2.0e5}, {"forces.suspension.damping", 1400}, {"bodies.wheel.mass", 12}};
+  RunOptions opt;
+  opt.rtol = 1e-10;
+  opt.atol = 1e-16;
+  for (const auto& p : params) opt.sensitivities.push_back(p.first);
+  const Result r = run(s, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  RunOptions tight;
+  tight.rtol = 1e-11;
+  tight.atol = 1e-17;
+  tight.formulation = "index2-ggl";
+  const auto& t = r.column("t");
+  for (const auto& [path, value] : params) {
+    for (const char* sensor : {"wheel_z", "wheel_vz"}) {
+      const auto fd = central_difference(s, path, value, 1e-4 * value, sensor, tight);
+      const auto& sens = sensitivity(r, sensor, path);
+      const double before = relative_error(t, sens, fd, 0, 0.2);
+      const double to_lift_off = relative_error(t, sens, fd, 0.2, 0.235);
+      const double after = relative_error(t, sens, fd, 0.235, 2);
+      std::printf("measured: Dynamics I d(%s)/d(%s): %.2e before the step, %.2e to the first lift-off, %.2e after\n",
+                  sensor, path.c_str(), before, to_lift_off, after);
+      EXPECT_LT(before, 1e-6) << sensor << " " << path;
+      EXPECT_LT(to_lift_off, 1e-4) << sensor << " " << path;
+      EXPECT_LT(after, 1e-4) << sensor << " " << path;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mbdae
