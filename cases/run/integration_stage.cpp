@@ -3,6 +3,7 @@
 // evaluated once into the Result's columns and handed to the sinks.
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 
@@ -18,6 +19,7 @@
 #include "formulation/initial_velocities.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
+#include "formulation/kinematic_sensitivities.h"
 #include "formulation/twin_sensitivities.h"
 
 namespace mbdae {
@@ -179,6 +181,7 @@ struct Sampler {
   std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now(), last_print = wall0;
   bool printed = false;
   std::string sink_error;  // a sink's failure (stops the run)
+  std::function<void(double)> after_row;  // each written row's sensitivities (kinematic samples)
 
   Sampler(RunContext& c_, const AnalysisStep& s, MultibodyDae& d, SetAsideWatch& w, double output_step)
       : c(c_), step(s), dae(d), set_aside(w), sensors(c_.system->sensors.size()), row(c_.result.columns.size()) {
@@ -206,6 +209,7 @@ struct Sampler {
     if (const int k = first_non_finite(row.data(), static_cast<int>(row.size())); k >= 0)
       throw non_finite_error("sensor " + c.result.columns[k], row[k], t);  // the driver stops the run
     for (size_t k = 0; k < row.size(); ++k) c.result.data[k].push_back(row[k]);
+    if (after_row) after_row(t);
     if (!c.sinks.empty()) {
       const Sample sample{t, row.data(), qo.data(), vo.data(), ao.empty() ? nullptr : ao.data(), &dae.state().modes,
                           dae.input_time(t)};
@@ -266,6 +270,28 @@ std::unique_ptr<TwinSensitivities> twin_sensitivities(RunContext& c, const Analy
   return std::make_unique<TwinSensitivities>(dae, make_dae(*c.system, f, fp, tol), std::move(twins), true);
 }
 
+// A kinematic step whose constraints fix every coordinate (Phi_q square) and whose outputs need
+// no accelerations: its samples' sensitivities by the implicit function theorem, none integrated.
+bool kinematic_by_ift(const RunContext& c, const AnalysisStep& step) {
+  if (!c.sensitivities || !c.sensitivities->active || step.type != AnalysisStep::Type::kKinematics ||
+      !KinematicSensitivities::applicable(*c.system))
+    return false;
+  for (int k : c.column_sensors)
+    if (c.system->sensors[k].type == SensorSpec::Type::kAcceleration) return false;
+  return true;
+}
+
+// The implicit-function-theorem sensitivities of a kinematic step, over the twins' models.
+std::unique_ptr<KinematicSensitivities> kinematic_sensitivities(RunContext& c, const AnalysisStep& step) {
+  std::vector<std::pair<const System*, const System*>> twins;
+  std::vector<double> deltas;
+  for (size_t i = 0; i < c.sensitivities->parameters.size(); ++i) {
+    twins.emplace_back(twin_context(c, i, 0)->system.get(), twin_context(c, i, 1)->system.get());
+    deltas.push_back(c.sensitivities->parameters[i].delta);
+  }
+  return std::make_unique<KinematicSensitivities>(*c.system, std::move(twins), std::move(deltas));
+}
+
 json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
   json stats;
   stats["steps"] = st.steps;
@@ -315,7 +341,8 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
   js["type"] = analysis_type(step.type).name;
   std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
-  if (c.sensitivities && c.sensitivities->active && !sensitivity_formulation(name)) {
+  const bool by_ift = kinematic_by_ift(c, step);
+  if (c.sensitivities && c.sensitivities->active && !by_ift && !sensitivity_formulation(name)) {
     // The scene's index3 (a formulation asked by name is refused before the run): the step runs
     // as index2-ggl, and says so (docs/sensitivities.md).
     js["formulation_with_sensitivities"] = "index2-ggl instead of the scene's " + name + ": " + kIndex3SensitivityNote;
@@ -345,7 +372,14 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   }
   SetAsideWatch watch(c, tol, io.rtol);
   Sampler sampler(c, step, *dae, watch, io.output_step);
-  const std::unique_ptr<TwinSensitivities> ts = twin_sensitivities(c, step, *dae, *f, fp, tol);
+  const std::unique_ptr<TwinSensitivities> ts = by_ift ? nullptr : twin_sensitivities(c, step, *dae, *f, fp, tol);
+  const std::unique_ptr<KinematicSensitivities> ks = by_ift ? kinematic_sensitivities(c, step) : nullptr;
+  if (ks) {
+    sampler.after_row = [&](double t) {
+      record_kinematic_sample(c, *ks, dae->state().modes, &dae->state().turns, t, sampler.qo.data(), sampler.vo.data());
+    };
+    js["sensitivity_method"] = "implicit function theorem at each sample (formulation/kinematic_sensitivities.h)";
+  }
   if (ts) {
     io.sensitivities = ts.get();
     io.sensitivity_output = [&](double t, const double* yy, const double* yyp, const double* const* s,

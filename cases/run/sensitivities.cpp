@@ -13,6 +13,7 @@
 #include "core/finite_check.h"
 #include "formulation/mechanics.h"  // initial_modes
 #include "formulation/model_rules.h"  // did_you_mean
+#include "formulation/kinematic_sensitivities.h"
 #include "formulation/twin_sensitivities.h"
 
 namespace mbdae {
@@ -139,6 +140,11 @@ std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c) {
   return rs;
 }
 
+bool wrote_row(const RunContext& c, double t) {
+  const Result& r = c.result;
+  return r.rows() == r.sensitivities[0].size() + 1 && r.data[0].back() == t;
+}
+
 RunContext* twin_context(RunContext& c, size_t parameter, int side) {
   if (!c.sensitivities || !c.sensitivities->active) return nullptr;
   return c.sensitivities->parameters[parameter].twin[side]->context.get();
@@ -184,11 +190,26 @@ void follow_static_stage(RunContext& c, int step, json& js) {
 void record_sensitivity_sample(RunContext& c, TwinSensitivities& ts, double t, const double* y, const double* yp,
                                const double* const* s, const double* const* sp, bool project) {
   RunSensitivities& rs = *c.sensitivities;
+  if (!rs.active || !wrote_row(c, t)) return;
+  if (!ts.sensors(t, y, yp, s, sp, project, rs.sensor_work)) return sensitivities_failed(c, "output_failed", ts.failure());
+  record_sensitivity_row(c, t, s);
+}
+
+void record_kinematic_sample(RunContext& c, KinematicSensitivities& ks, const std::vector<char>& modes,
+                             const CoordinateTurns* turns, double t, const double* q, const double* v) {
+  RunSensitivities& rs = *c.sensitivities;
+  if (!rs.active || !wrote_row(c, t)) return;
+  if (!ks.sensors(modes, turns, q, v, t, rs.sensor_work, rs.position_work))
+    return sensitivities_failed(c, "singular", ks.failure() + " (t = " + number_text(t) + ")");
+  std::vector<const double*> dq;
+  for (const auto& x : rs.position_work) dq.push_back(x.data());
+  record_sensitivity_row(c, t, dq.data());
+}
+
+void record_sensitivity_row(RunContext& c, double t, const double* const* s) {
+  RunSensitivities& rs = *c.sensitivities;
   Result& r = c.result;
-  const size_t rows = r.sensitivities[0].size();
-  if (!rs.active || r.rows() != rows + 1 || r.data[0].back() != t) return;  // the run wrote no row here
-  std::vector<std::vector<double>>& ds = rs.sensor_work;
-  if (!ts.sensors(t, y, yp, s, sp, project, ds)) return sensitivities_failed(c, "output_failed", ts.failure());
+  const std::vector<std::vector<double>>& ds = rs.sensor_work;
   const size_t np = rs.parameters.size();
   std::vector<double>& row = rs.row_work;
   row.resize(r.sensitivity_columns.size());

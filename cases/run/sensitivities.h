@@ -22,6 +22,8 @@ namespace mbdae {
 
 struct RunContext;
 class TwinSensitivities;
+class KinematicSensitivities;
+struct CoordinateTurns;
 
 struct TwinRun {
   Scene scene;
@@ -46,6 +48,7 @@ struct RunSensitivities {
   std::vector<double> event_times;  // events met by an integration with sensitivities
   std::vector<std::vector<double>> last_positions;  // per parameter, dq/dp at the last sample
   std::vector<std::vector<double>> sensor_work;     // a sample's d(sensor)/dp per parameter
+  std::vector<std::vector<double>> position_work;   // a kinematic sample's dq/dp per parameter
   std::vector<double> row_work;
 };
 
@@ -73,9 +76,18 @@ std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c);
 void follow_static_stage(RunContext& c, int step, nlohmann::ordered_json& js);
 // The twins' contexts for integration stage `step` (null when the sensitivities are off).
 RunContext* twin_context(RunContext& c, size_t parameter, int side);
-// One sample's row of sensitivities into c.result.sensitivities, if the run wrote that sample.
+// One sample's row of sensitivities into c.result.sensitivities, if the run wrote that sample:
+// from the integrated sensitivities s, s' (IDAS), or at a kinematic sample's consistent (q, v)
+// by the implicit function theorem.
 void record_sensitivity_sample(RunContext& c, TwinSensitivities& ts, double t, const double* y, const double* yp,
                                const double* const* s, const double* const* sp, bool project);
+void record_kinematic_sample(RunContext& c, KinematicSensitivities& ks, const std::vector<char>& modes,
+                             const CoordinateTurns* turns, double t, const double* q, const double* v);
+// The row of rs.sensor_work at t, and the positions' sensitivities s[i] (nq each) kept for the
+// twins (follow_integration_stage).
+void record_sensitivity_row(RunContext& c, double t, const double* const* s);
+// Whether the run's last row is the sample at t, with no sensitivity row yet.
+bool wrote_row(const RunContext& c, double t);
 // The sensitivity equations' work in the step's statistics; the events met.
 void sensitivity_statistics(RunContext& c, const IdaStats& st, nlohmann::ordered_json& stats);
 // After an integration stage: the twins' positions from the run's and the last sensitivities.
