@@ -83,6 +83,19 @@ class Result:
             self._sens_table = pd.DataFrame(data, index=pd.Index(self._sens_arrays[0], name="t"), columns=index)
         return self._sens_table
 
+    def normalized_sensitivities(self):
+        """The sensitivities relative to the parameters' values and the sensors' scales:
+        (p / max|y|) dy/dp, max|y| each sensor's largest magnitude over the run (a pointwise
+        (p / y) dy/dp is unbounded where y crosses zero). A DataFrame like `sensitivities`; a
+        sensor that is zero throughout gets no column. None without sensitivities."""
+        table = self.sensitivities
+        if table is None:
+            return None
+        values = {p["path"]: p["value"] for p in self.summary["sensitivities"]["parameters"]}
+        keep = [c for c in table.columns if np.abs(self[c[0]]).max() > 0]
+        scale = np.array([values[p] / np.abs(self[s]).max() for s, p in keep])
+        return table[keep] * scale
+
     @property
     def sensitivity_units(self):
         """{(sensor, parameter): unit} of the sensitivities' columns ("m/(N/m)", ...)."""

@@ -99,7 +99,7 @@ class Scene:
         return Scene(self._core.copy(), self._path, self._text, self.overrides)
 
     # ---- Running ----------------------------------------------------------------------------
-    def run_options(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None):
+    def run_options(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, sensitivities=None):
         """RunOptions with the command line's range checks (`mbdae run --rtol ...`, cases/field_ranges.h):
         a value out of range raises ValueError naming the option, as the CLI's message does."""
         opt = _core.RunOptions()
@@ -111,6 +111,8 @@ class Scene:
             opt.output_step = _number("output_step", output_step)
         if formulation is not None:
             opt.formulation = str(formulation)
+        if sensitivities is not None:
+            opt.sensitivities = _paths("sensitivities", sensitivities)
         errors = _core.option_errors(self._core, opt)
         if errors:
             raise ValueError("\n".join(errors))
@@ -137,7 +139,7 @@ class Scene:
         output sensor (Result.sensitivities, docs/sensitivities.md). Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
-        opt = self.run_options(rtol, atol, formulation, output_step, analysis)
+        opt = self.run_options(rtol, atol, formulation, output_step, analysis, sensitivities)
         if out is not None:
             opt.out_dir = str(out)
         temporary = None
@@ -153,8 +155,6 @@ class Scene:
             if not isinstance(error_warnings, bool):
                 raise ValueError(f"error_warnings expects True or False, got {error_warnings!r}")
             opt.error_warnings = error_warnings
-            if sensitivities is not None:
-                opt.sensitivities = _paths("sensitivities", sensitivities)
             result = Result._from_core(_scene_errors(_core.run, self._core, opt))
         except BaseException:
             if temporary:

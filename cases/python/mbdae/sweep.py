@@ -183,7 +183,7 @@ def sweep(scene, params, out, client=None, metrics=None, options=None, workers=N
 
     params: a grid {path: [values]} or a list of {path: value}; paths are scene parameters
       (forces.suspension.damping, bodies.chassis.points.bp1.2; scene.parameters() lists them) or
-      run options (rtol, atol, formulation, output_step, analysis).
+      run options (rtol, atol, formulation, output_step, analysis, sensitivities).
     out: the folder (OUT/runs/KEY.h5 each run's samples, KEY.json its row, OUT/runs.csv,
       OUT/sweep.json). Runs finished there with the same inputs are reused (files verified);
       a folder holding other runs is refused unless extend=True (the runs are added).
@@ -208,6 +208,8 @@ def sweep(scene, params, out, client=None, metrics=None, options=None, workers=N
         raise ValueError(f"worker_timeout expects seconds > 0, got {worker_timeout!r}")
     check_parameters(scene, runs)
     check_metrics(scene, metrics)
+    if "sensitivities" in options:  # the paths against the scene, before the first run
+        scene.run_options(sensitivities=options["sensitivities"], formulation=options.get("formulation"))
     out = Path(out)
     try:
         (out / "runs").mkdir(parents=True, exist_ok=True)

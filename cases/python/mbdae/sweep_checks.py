@@ -13,7 +13,7 @@ import numpy as np
 from .errors import SceneError
 
 # Sweep keys that are run options (as scene.run's arguments), not scene parameter paths.
-RUN_OPTIONS = ("rtol", "atol", "formulation", "output_step", "analysis")
+RUN_OPTIONS = ("rtol", "atol", "formulation", "output_step", "analysis", "sensitivities")
 
 
 def plain(v):
