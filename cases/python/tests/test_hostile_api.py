@@ -107,3 +107,40 @@ def test_nan_load_is_a_solve_error_naming_the_load(tmp_path):
     assert 5 <= r.rows <= 6 and all(t <= 0.05 for t in r["t"])
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "non_finite"
+
+
+# Issue 24: sensitivities asked from Python get the CLI's checks before anything runs.
+@pytest.mark.parametrize("value, words", [
+    (5, "expects a parameter path or a list of them"),
+    ([""], "non-empty strings"),
+    ([3.0], "non-empty strings"),
+    (["forces.motr.torque"], "no such parameter"),
+    (["bodies.wheel.mas"], "did you mean 'bodies.wheel.mass'"),
+    (["gravity"], "not a single number; name one element: gravity.0"),
+    (["analysis.dynamics.t_end"], "a setting of the analysis"),
+    (["bodies.wheel.mass", "bodies.wheel.mass"], "asked twice"),
+])
+def test_bad_sensitivity_requests_are_refused(value, words, tmp_path):
+    with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(".", r"\.")):
+        wheel().run(sensitivities=value, out=tmp_path / "out")
+    assert not (tmp_path / "out" / "summary.json").exists()
+
+
+def test_sensitivities_not_with_index3_by_name():
+    with pytest.raises(ValueError, match="not with formulation index3"):
+        wheel().run(sensitivities=["bodies.wheel.inertia.zz"], formulation="index3")
+
+
+def test_sensitivities_in_the_result_and_the_folder(tmp_path):
+    import pickle
+    import numpy as np
+    # A constant torque T on inertia J from rest: angle = T t^2 / (2 J), d(angle)/dJ = -T t^2 / (2 J^2).
+    r = wheel().run(sensitivities="bodies.wheel.inertia.zz", out=tmp_path / "out", rtol=1e-10)
+    s = r.sensitivities[("angle", "bodies.wheel.inertia.zz")]
+    t = s.index.to_numpy()
+    assert np.allclose(s.to_numpy(), -2 * t ** 2 / (2 * 0.5 ** 2), rtol=0, atol=1e-8)
+    assert r.sensitivity_units[("angle", "bodies.wheel.inertia.zz")] == "rad/(kg m^2)"
+    assert pickle.loads(pickle.dumps(r)).sensitivities.equals(r.sensitivities)
+    assert (tmp_path / "out" / "sensitivities.csv").exists()
+    assert r.summary["sensitivities"]["status"] == "ok"
+    assert wheel().run().sensitivities is None
