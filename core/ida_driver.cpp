@@ -659,8 +659,8 @@ IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>
   r.output = &output;
   try {
     open_run(r, y0, yp0);
-  } catch (const SolveError& e) {  // initial sensitivities that cannot be made, a refused setting
-    if (!r.mem) throw;
+  } catch (const SolveError& e) {  // initial sensitivities that cannot be made: a failed run
+    if (!r.mem || e.status == "internal_error") throw;  // a refused setting names its SUNDIALS call
     fail(r, e.status, e.what(), o.t0);
     r.stats.cpu_seconds = cpu_now() - cpu0;
     return r.stats;

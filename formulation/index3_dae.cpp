@@ -54,7 +54,13 @@ void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* 
   double rmax = abs_tol_.length;
   for (int i = 0; i < nq_; i += 7) rmax = std::fmax(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
   const double w_length = 1.0 / (kRoundingFloor * rmax), w_rotation = 1.0 / kRoundingFloor;
-  for (int i = 0; i < nq_; ++i) w[i] = std::fmin(w[i] * f, std::fmax(w[i], i % 7 < 3 ? w_length : w_rotation));
+  int floored = 0;
+  for (int i = 0; i < nq_; ++i) {
+    const double wanted = w[i] * f, floor = std::fmax(w[i], i % 7 < 3 ? w_length : w_rotation);
+    floored += wanted > floor;
+    w[i] = std::fmin(wanted, floor);
+  }
+  count_floor(floored);
 }
 
 

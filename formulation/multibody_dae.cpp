@@ -150,11 +150,15 @@ void MultibodyDae::error_per_unit_span(double h, const double* y, double* w) con
   const double e = kSpanRoundingFloor;
   const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
   const double w_velocity = 1.0 / (e * std::fmax(vmax, rmax / h)), w_rate = 1.0 / (e * std::fmax(1.0, 1.0 / h));
+  int floored = 0;
   for (int i = 0; i < nq_; ++i) {
     const bool euler = i % 7 >= 3;
-    w[i] = std::fmin(w[i] * f, std::fmax(w[i], euler ? w_rotation : w_length));
+    const double wanted = w[i] * f, floor = std::fmax(w[i], euler ? w_rotation : w_length);
+    floored += wanted > floor;
+    w[i] = std::fmin(wanted, floor);
     w[nq_ + i] = std::fmin(w[nq_ + i] * f, std::fmax(w[nq_ + i], euler ? w_rate : w_velocity));
   }
+  count_floor(floored);
 }
 
 void MultibodyDae::switches(double t_in, const double* y, double* g) {

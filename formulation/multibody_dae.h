@@ -156,6 +156,26 @@ class MultibodyDae : public DaeProblem {
   // (positions max(L, |r|), velocities max(L/T, |v|, |r|/h)), never looser than before.
   void error_per_unit_span(double h, const double* y, double* w) const;
   static constexpr double kSpanRoundingFloor = 1e2 * 2.220446049250313e-16;
+  // How often the error control asked for positions below their rounding: calls of the weights,
+  // and those where the rounding floor replaced the control's tolerance for most position
+  // components (the error then stops following rtol: docs/formulation.md, "Error control").
+  struct FloorCount {
+    long weights = 0, floored = 0;
+  };
+  mutable FloorCount floor_count_;
+  void count_floor(int floored_components) const {
+    ++floor_count_.weights;
+    if (2 * floored_components > nq_) ++floor_count_.floored;
+  }
+
+ public:
+  // The fraction of error-weight evaluations whose position tolerances sat at the rounding
+  // floor (0 for a control without one).
+  double rounding_floor_fraction() const {
+    return floor_count_.weights ? double(floor_count_.floored) / floor_count_.weights : 0.0;
+  }
+
+ protected:
   // The integrator's step: 1/cj of the last Newton matrix (h before the first one).
   double newton_step(double h) const { return newton_cj_ > 0 ? 1.0 / newton_cj_ : h; }
   AbsoluteTolerances abs_tol_;

@@ -292,6 +292,25 @@ std::unique_ptr<KinematicSensitivities> kinematic_sensitivities(RunContext& c, c
   return std::make_unique<KinematicSensitivities>(*c.system, std::move(twins), std::move(deltas));
 }
 
+// An error control that asked for positions below their rounding in most steps: the error
+// stops following rtol (docs/formulation.md, "Error control"). A note in the step and the
+// summary ("notes"), and on stderr unless quiet: the error itself may still be within the
+// promise (a damped mechanism forgets its errors), which only an estimate can tell.
+void note_rounding_floor(RunContext& c, const std::string& formulation, double rtol, double fraction, json& js) {
+  if (!(fraction > 0.5)) return;
+  const bool index3 = formulation.rfind("index3", 0) == 0;
+  char buf[600];
+  std::snprintf(buf, sizeof buf,
+                "rtol %g: the %s error control asked for positions below their rounding (%s of the model's "
+                "positions) in %.0f %% of the steps, so the error no longer falls with rtol here: a tighter rtol buys "
+                "steps, not accuracy (docs/formulation.md, \"Error control\")%s; --error-estimate measures the error",
+                rtol, formulation.c_str(), index3 ? "1e3 eps" : "100 eps", 100 * fraction,
+                index3 ? "; index2-ggl follows rtol further" : "");
+  js["notes"].push_back(buf);
+  c.result.summary["notes"].push_back(buf);
+  if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
+}
+
 json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
   json stats;
   stats["steps"] = st.steps;
@@ -394,6 +413,8 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   c.turns = dae->state().turns;
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
   if (ts) sensitivity_statistics(c, st, js["statistics"]);
+  js["statistics"]["rounding_floor_fraction"] = dae->rounding_floor_fraction();
+  note_rounding_floor(c, name, io.rtol, dae->rounding_floor_fraction(), js);
   follow_integration_stage(c);
   js["event_times"] = st.event_times;
   js["breakpoint_times"] = st.breakpoint_times;

@@ -180,5 +180,28 @@ TEST(ErrorEstimateApi, ClampedComparisonToleranceIsLabelled) {
   EXPECT_NEAR(e.to_json()["comparison"]["rtol"].get<double>(), 3e-14, 1e-27);
 }
 
+// The fast mechanism: index3's position tolerance sits at the rounding floor from about rtol
+// 1e-7 on (docs/formulation.md, "Index 3 at tight tolerances"); the run says so in a note. At
+// rtol 1e-4 it does not, nor does index2-ggl at 1e-8 (its floor is at about 1e-10).
+TEST(ErrorControlNotes, RoundingFloorIsNoted) {
+  const Scene scene = load_scene(source(kFast));
+  auto notes = [&](const char* formulation, double rtol) {
+    RunOptions o;
+    o.rtol = rtol;
+    o.formulation = formulation;
+    const Result r = run(scene, o);
+    EXPECT_TRUE(r.ok()) << r.message;
+    const double fraction = r.summary["steps"].back()["statistics"]["rounding_floor_fraction"].get<double>();
+    return std::make_pair(r.summary.contains("notes") ? r.summary["notes"].size() : 0u, fraction);
+  };
+  const auto tight = notes("index3", 1e-9);
+  EXPECT_EQ(tight.first, 1u);
+  EXPECT_GT(tight.second, 0.5);
+  const auto loose = notes("index3", 1e-4);
+  EXPECT_EQ(loose.first, 0u);
+  EXPECT_LT(loose.second, 0.5);
+  EXPECT_EQ(notes("index2-ggl", 1e-8).first, 0u);
+}
+
 }  // namespace
 }  // namespace mbdae
