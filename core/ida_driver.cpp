@@ -317,9 +317,6 @@ void open_sensitivities(IdaRun& r) {
   if (!sp) return;
   r.ns = sp->count();
   for (N_Vector** v : {&r.s, &r.sp, &r.ss, &r.sps}) *v = check(N_VCloneVectorArray(r.ns, r.y), "N_VCloneVectorArray");
-  // Fused vector operations for the sensitivities only (IDAS clones its own from these): one pass
-  // over all ns vectors instead of ns; the state's vectors, and so its results, are unchanged.
-  for (int i = 0; i < r.ns; ++i) check(N_VEnableFusedOps_Serial(r.s[i], SUNTRUE), "N_VEnableFusedOps_Serial");
   r.s_data = data(r.s, r.ns);
   r.sp_data = data(r.sp, r.ns);
   r.ss_data = data(r.ss, r.ns);

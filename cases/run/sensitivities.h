@@ -49,6 +49,7 @@ struct RunSensitivities {
   std::vector<std::vector<double>> last_positions;  // per parameter, dq/dp at the last sample
   std::vector<std::vector<double>> sensor_work;     // a sample's d(sensor)/dp per parameter
   std::vector<std::vector<double>> position_work;   // a kinematic sample's dq/dp per parameter
+  std::vector<const double*> position_pointers;     // their data, as record_sensitivity_row takes them
   std::vector<double> row_work;
 };
 
