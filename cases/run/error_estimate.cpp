@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <future>
 
+#include "cases/run/sensitivities.h"
 #include "cases/scene/analysis_types.h"
 #include "cases/scene/field_ranges.h"
 #include "core/output.h"
@@ -209,6 +210,11 @@ RunOptions comparison_options(const Scene& scene, const RunOptions& options, dou
   RunOptions c = options;
   c.verbose = c.progress = c.report_failures = false;
   c.sensitivities.clear();  // the estimate compares the outputs only
+  // A run with sensitivities runs the scene's index3 steps as index2-ggl (cases/run/sensitivities.h):
+  // the comparison run must use the same formulation.
+  if (!options.sensitivities.empty() && options.formulation.empty())
+    for (const AnalysisStep& s : scene.steps)
+      if (integrates(s) && !sensitivity_formulation(s.formulation)) c.formulation = "index2-ggl";
   c.stop = stop;
   const double rtol = run_rtol(scene, options);
   // Tighter (rtol / factor) unless that leaves the tolerance's range: then looser by the same factor.
