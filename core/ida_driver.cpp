@@ -248,6 +248,7 @@ struct IdaRun {
   // Sensitivities (IdaOptions::sensitivities): ns vectors each of s and s' (the state's, kept
   // between IDAS calls) and of a sample's interpolated ones; their data pointers.
   int ns = 0;
+  bool sens_on = false;  // false once IDA failed with them (drop_sensitivities)
   N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
   std::vector<double*> s_data, sp_data, ss_data, sps_data;
   std::vector<double> pbar;
@@ -333,6 +334,7 @@ void open_sensitivities(IdaRun& r) {
   for (int i = 0; i < r.ns; ++i) r.pbar[i] = sp->scale(i);
   check(IDASetSensParams(r.mem, nullptr, r.pbar.data(), nullptr), "IDASetSensParams");
   check(IDASetSensErrCon(r.mem, sp->in_error_test() ? SUNTRUE : SUNFALSE), "IDASetSensErrCon");
+  r.sens_on = true;
 }
 
 // Breakpoints inside the span end segments. One at t1 makes the end a stop time (next_stop).
@@ -405,7 +407,7 @@ bool interpolate(IdaRun& r, double tt, int k, N_Vector v) {
 
 // IDAS's interpolants of s_i and s_i' at tt (nothing without sensitivities).
 bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) {
-  for (int i = 0; i < r.ns; ++i) {
+  for (int i = 0; r.sens_on && i < r.ns; ++i) {
     for (int k = 0; k < 2; ++k) {
       const int flag = IDAGetSensDky1(r.mem, tt, k, i, k == 0 ? s[i] : sp[i]);
       if (flag == IDA_SUCCESS) continue;
@@ -451,7 +453,7 @@ void emit(IdaRun& r, double ts, const double* yy, const double* yyp, double* con
   if (!finite(r, yy, ts, "") || (yyp && !finite(r, yyp, ts, "derivative of "))) return;
   try {
     const bool go_on = (*r.output)(ts, yy, yyp);
-    if (r.ns > 0 && r.o->sensitivity_output) r.o->sensitivity_output(ts, yy, yyp, s, sp);
+    if (r.sens_on && r.o->sensitivity_output) r.o->sensitivity_output(ts, yy, yyp, s, sp);
     if (!go_on) r.stop_requested = true;
   } catch (const SolveError& e) {
     fail(r, e.status, e.what(), ts);
@@ -500,7 +502,7 @@ void keep_step(IdaRun& r) {
 void reinit(IdaRun& r, double tt) {
   collect(r.mem, r.stats);
   check(IDAReInit(r.mem, tt, r.y, r.yp), "IDAReInit");
-  if (r.ns > 0) check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
+  if (r.sens_on) check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
 }
 
 // A step past t1: the end state and the last samples are interpolated; a root beyond t1 is no
@@ -557,7 +559,7 @@ bool restart(IdaRun& r, const int* roots) {
   r.problem->set_segment(r.t, segment_end(r));
   try {
     r.problem->restart(r.t, data(r.y), data(r.yp), roots);
-    if (r.ns > 0) {  // the sensitivities at t (IDAS's), made consistent with the restarted state
+    if (r.sens_on) {  // the sensitivities at t (IDAS's), made consistent with the restarted state
       r.o->sensitivities->set_segment(r.t, segment_end(r));
       if (!interpolate_sensitivities(r, r.t, r.s, r.sp)) return false;
       r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
@@ -576,12 +578,39 @@ bool restart(IdaRun& r, const int* roots) {
   return true;
 }
 
+// IDA failed with the sensitivities on: the run goes on without them from its last accepted
+// step (their rows end there; IdaStats::sensitivity_failure says why). Where the state itself
+// cannot go on, it fails again there and the run ends with that failure.
+bool drop_sensitivities(IdaRun& r, int flag) {
+  double tt = r.t;
+  IDAGetCurrentTime(r.mem, &tt);
+  std::ostringstream os;
+  os << "IDA failed with the sensitivities at t = " << tt << " (" << ida_flag_name(flag) << ")";
+  if (!r.ud.callback_error.empty()) os << ": " << r.ud.callback_error;
+  os << "; the run went on without them from t = " << r.t_prev;
+  r.stats.sensitivity_failure = os.str();
+  r.ud.callback_error.clear();
+  r.ud.callback_status.clear();
+  r.ud.non_finite = -1;
+  check(IDASensToggleOff(r.mem), "IDASensToggleOff");
+  r.sens_on = false;
+  std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
+  std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
+  r.t = r.t_prev;
+  choose_initial_step(r, r.t);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
+  reinit(r, r.t);
+  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+  return true;
+}
+
 // One IDA step and what follows it (samples, an event, a breakpoint). False: the run ends.
 bool advance(IdaRun& r) {
   const IdaOptions& o = *r.o;
   double tret = r.t;
   const int flag = IDASolve(r.mem, o.t1, &tret, r.y, r.yp, IDA_ONE_STEP);
   if (flag < 0) {
+    if (r.sens_on && drop_sensitivities(r, flag)) return true;
     ida_failure(r, flag);
     return false;
   }

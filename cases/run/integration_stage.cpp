@@ -413,6 +413,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   c.turns = dae->state().turns;
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
   if (ts) sensitivity_statistics(c, st, js["statistics"]);
+  if (!st.sensitivity_failure.empty()) sensitivities_failed(c, "integration_failed", st.sensitivity_failure);
   js["statistics"]["rounding_floor_fraction"] = dae->rounding_floor_fraction();
   note_rounding_floor(c, name, io.rtol, dae->rounding_floor_fraction(), js);
   follow_integration_stage(c);

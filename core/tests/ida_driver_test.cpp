@@ -8,6 +8,7 @@
 // located by root finding.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -245,6 +246,87 @@ TEST(IdaDriver, RefusedSettingNamesTheSundialsCall) {
     EXPECT_NE(std::string(e.what()).find("IDASetMaxOrd"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("IDA_ILL_INPUT"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace mbdae
+
+namespace mbdae {
+namespace {
+
+// The sensitivity of DecayProblem to its initial value y0(0) = p: s0' = -s0, s1 = 2 s0, s(0) =
+// (1, 2), so s0(t) = exp(-t). `fail_after`: its residual cannot be evaluated after that time.
+class DecayInitialValue : public SensitivityProblem {
+ public:
+  double fail_after = 1e300;
+  int count() const override { return 1; }
+  double scale(int) const override { return 1.0; }
+  int residual(double t, const double*, const double*, const double*, const double* const* s, const double* const* sp,
+               double* const* r) override {
+    if (t > fail_after) return -1;
+    r[0][0] = sp[0][0] + s[0][0];
+    r[0][1] = s[0][1] - 2 * s[0][0];
+    return 0;
+  }
+  void initial(double, const double*, const double*, double* const* s, double* const* sp) override {
+    s[0][0] = 1, s[0][1] = 2, sp[0][0] = -1, sp[0][1] = -2;
+  }
+  void restart(double, const double*, const double*, double* const* s, double* const* sp) override {
+    sp[0][0] = -s[0][0];
+    sp[0][1] = -2 * s[0][0];
+  }
+  bool in_error_test() const override { return true; }
+};
+
+TEST(IdaDriverSensitivities, FollowTheClosedFormThroughABreakpoint) {
+  DecayProblem p;
+  p.step_input = true;  // a breakpoint at 0.5: the sensitivities restart there
+  DecayInitialValue sens;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.rtol = 1e-10;
+  o.atol = 1e-12;
+  o.output_step = 0.1;
+  o.sensitivities = &sens;
+  double worst = 0;
+  int rows = 0;
+  o.sensitivity_output = [&](double t, const double*, const double*, const double* const* s, const double* const*) {
+    worst = std::max({worst, std::fabs(s[0][0] - std::exp(-t)), std::fabs(s[0][1] - 2 * std::exp(-t))});
+    ++rows;
+  };
+  const IdaStats st = integrate(p, o, y, yp, [](double, const double*, const double*) { return true; });
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_EQ(rows, 21);
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_GT(st.sensitivity_residual_evals, 0);
+  EXPECT_TRUE(st.sensitivity_failure.empty());
+}
+
+// Sensitivities that cannot go on stop; the run goes on without them to its end.
+TEST(IdaDriverSensitivities, AFailureStopsThemNotTheRun) {
+  DecayProblem p;
+  DecayInitialValue sens;
+  sens.fail_after = 1.0;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.output_step = 0.1;
+  o.sensitivities = &sens;
+  double last_sensitivity = -1, last_sample = -1;
+  o.sensitivity_output = [&](double t, const double*, const double*, const double* const*, const double* const*) {
+    last_sensitivity = t;
+  };
+  const IdaStats st = integrate(p, o, y, yp, [&](double t, const double*, const double*) {
+    last_sample = t;
+    return true;
+  });
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_DOUBLE_EQ(last_sample, 2.0);
+  EXPECT_LE(last_sensitivity, 1.0 + 1e-12);
+  EXPECT_GT(last_sensitivity, 0.5);
+  EXPECT_NE(st.sensitivity_failure.find("IDA failed with the sensitivities"), std::string::npos) << st.sensitivity_failure;
+  EXPECT_NEAR(y[0], std::exp(-2.0), 1e-5);
 }
 
 }  // namespace
