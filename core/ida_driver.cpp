@@ -43,13 +43,15 @@ struct UserData {
   N_Vector state_weights = nullptr;    // the state's weight vector (IDA's first weights_fn call)
   const double* id = nullptr;          // the error test's mask
   double state_size = 0;               // max |y_i| over the error-tested components, at the last state weights
+  std::vector<double> state_y;         // the state at the last state weights
   std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
   std::vector<double*> r_out;
 };
 
 // With sensitivities, IDAS calls weights_fn for the state (first, and always with the same
 // weight vector) and for each sensitivity at pbar_i s_i. The sensitivities' tolerances never go
-// below kSensitivityNoise times the state's size: their residual's parameter derivative is a
+// below kSensitivityNoise times the state's size (or the component's own, where larger: the
+// multipliers, in newtons): their residual's parameter derivative is a
 // difference over twin models (formulation/twin_sensitivities.h) whose rounding is about 1e5 eps
 // of the state, above the rounding-level floors of the state's own weights (measured: index2-ggl
 // on A01 at rtol 1e-8 stopped at its first step without this floor).
@@ -64,11 +66,13 @@ void sensitivity_weight_floor(UserData* u, N_Vector y, N_Vector w) {
     u->state_size = 0;
     for (int i = 0; i < n; ++i)
       if (u->id[i] > 0) u->state_size = std::fmax(u->state_size, std::fabs(yd[i]));
+    u->state_y.assign(yd, yd + n);  // sized once: no allocation after the first call
     return;
   }
-  const double floor = kSensitivityNoise * u->state_size;
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n && !u->state_y.empty(); ++i) {
+    const double floor = kSensitivityNoise * std::fmax(u->state_size, std::fabs(u->state_y[i]));
     if (floor > 0 && wd[i] * floor > 1) wd[i] = 1 / floor;
+  }
 }
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
@@ -419,6 +423,19 @@ bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) 
   return true;
 }
 
+// The sensitivities at the last accepted step t_prev into r.s and r.sp: IDAS's interpolant
+// there, or, before any step since the last (re)initialization, the values it was given (they
+// are still in r.s, r.sp). False (the run not failed) if IDAS cannot give them.
+bool sensitivities_at_last_step(IdaRun& r) {
+  long steps = 0;
+  if (IDAGetNumSteps(r.mem, &steps) != IDA_SUCCESS) return false;
+  for (int i = 0; steps > 0 && i < r.ns; ++i)
+    if (IDAGetSensDky1(r.mem, r.t_prev, 0, i, r.s[i]) != IDA_SUCCESS ||
+        IDAGetSensDky1(r.mem, r.t_prev, 1, i, r.sp[i]) != IDA_SUCCESS)
+      return false;
+  return true;
+}
+
 // IDA stopped with an error: the message names the worst error estimates and IDA's own words.
 void ida_failure(IdaRun& r, int flag) {
   double tt = r.t;
@@ -523,7 +540,10 @@ bool step_onto_root(IdaRun& r, double t_root) {
   if (r.ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
     // The sensitivities at the last accepted step, from IDAS's interpolant (it passes through
     // that step's solution), before IDA's history is reset.
-    if (!interpolate_sensitivities(r, r.t_prev, r.s, r.sp)) return false;
+    if (r.sens_on && !sensitivities_at_last_step(r)) {
+      fail(r, "integration_failed", "the sensitivities at t = " + std::to_string(r.t_prev) + " cannot be had", r.t_prev);
+      return false;
+    }
     std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
     std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
     check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
@@ -578,10 +598,34 @@ bool restart(IdaRun& r, const int* roots) {
   return true;
 }
 
+// The sensitivities' robust residual from the last accepted step: their values there (IDAS's
+// interpolant), made consistent by the problem, and IDA anew. False if that cannot be done.
+bool retry_sensitivities(IdaRun& r) {
+  if (!sensitivities_at_last_step(r)) return false;
+  r.ud.callback_error.clear();
+  r.ud.callback_status.clear();
+  r.ud.non_finite = -1;
+  std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
+  std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
+  r.t = r.t_prev;
+  try {
+    r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
+  } catch (const SolveError&) {
+    return false;
+  }
+  r.stats.sensitivity_fallback_time = r.t;
+  choose_initial_step(r, r.t);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
+  reinit(r, r.t);
+  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+  return true;
+}
+
 // IDA failed with the sensitivities on: the run goes on without them from its last accepted
 // step (their rows end there; IdaStats::sensitivity_failure says why). Where the state itself
 // cannot go on, it fails again there and the run ends with that failure.
 bool drop_sensitivities(IdaRun& r, int flag) {
+  if (r.o->sensitivities->fall_back() && retry_sensitivities(r)) return true;
   double tt = r.t;
   IDAGetCurrentTime(r.mem, &tt);
   std::ostringstream os;

@@ -40,27 +40,47 @@ void TwinSensitivities::set_segment(double t_start, double t_end) {
 
 int TwinSensitivities::residual(double t, const double* y, const double* yp, const double*, const double* const* s,
                                 const double* const* sp, double* const* r) {
-  const int n = run_.size();
   follow(*base_);
-  base_->jacobian(t, 0.0, y, yp, a0_.data());
+  if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
   if (const int flag = base_->residual(t, y, yp, r0_.data()); flag != 0) return flag;
-  const CscPattern& pat = base_->jacobian_pattern();
   for (size_t i = 0; i < twins_.size(); ++i) {
-    ParameterTwins& p = twins_[i];
-    for (int k = 0; k < n; ++k) ypt_[k] = yp[k] + p.scale * sp[i][k];  // F_y' s' (F affine in y')
-    if (const int flag = base_->residual(t, y, ypt_.data(), r[i]); flag != 0) return flag;
-    for (int k = 0; k < n; ++k) r[i][k] = (r[i][k] - r0_[k]) / p.scale;
-    for (int sign = 1; sign >= -1; sign -= 2) {
-      MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
-      follow(twin);
-      const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data());
-      if (flag != 0) return flag;
-    }
-    const double inv = 0.5 / p.delta;
-    for (int k = 0; k < n; ++k) r[i][k] += (rp_[k] - rm_[k]) * inv;
-    for (int c = 0; c < n; ++c)  // + A0 s, column by column
-      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[i][pat.rowind[k]] += a0_[k] * s[i][c];
+    int flag = add_state_terms(t, y, yp, twins_[i], s[i], sp[i], r[i]);
+    if (flag == 0) flag = add_parameter_term(t, y, yp, twins_[i], r[i]);
+    if (flag != 0) return flag;
   }
+  return 0;
+}
+
+// r = F_y s + F_y' s': F_y' s' by a difference in y' (F is affine in y'), F_y s by a central
+// difference along s or, after fall_back(), by A0.
+int TwinSensitivities::add_state_terms(double t, const double* y, const double* yp, const ParameterTwins& p,
+                                       const double* s, const double* sp, double* r) {
+  const int n = run_.size();
+  for (int k = 0; k < n; ++k) ypt_[k] = yp[k] + p.scale * sp[k];
+  if (const int flag = base_->residual(t, y, ypt_.data(), r); flag != 0) return flag;
+  for (int k = 0; k < n; ++k) r[k] = (r[k] - r0_[k]) / p.scale;
+  if (exact_) {
+    const CscPattern& pat = base_->jacobian_pattern();
+    for (int c = 0; c < n; ++c)
+      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[pat.rowind[k]] += a0_[k] * s[c];
+    return 0;
+  }
+  for (int sign = 1; sign >= -1; sign -= 2) {
+    for (int k = 0; k < n; ++k) yt_[k] = y[k] + sign * p.delta * s[k];
+    if (const int flag = base_->residual(t, yt_.data(), yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
+  }
+  for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
+  return 0;
+}
+
+// r += F_p by the twins at the same (y, y').
+int TwinSensitivities::add_parameter_term(double t, const double* y, const double* yp, ParameterTwins& p, double* r) {
+  for (int sign = 1; sign >= -1; sign -= 2) {
+    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+    follow(twin);
+    if (const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
+  }
+  for (int k = 0; k < run_.size(); ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
   return 0;
 }
 

@@ -235,6 +235,8 @@ void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
   stats["sensitivity_residual_evaluations"] = st.sensitivity_residual_evals;
   stats["sensitivity_nonlinear_iterations"] = st.sensitivity_nonlinear_iterations;
   stats["sensitivity_nonlinear_failures"] = st.sensitivity_nonlinear_failures;
+  // Where F_y s went from differences along s to the assembled Newton matrix (formulation/twin_sensitivities.h).
+  if (st.sensitivity_fallback_time >= 0) stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
   RunSensitivities& rs = *c.sensitivities;
   rs.event_times.insert(rs.event_times.end(), st.event_times.begin(), st.event_times.end());
 }
@@ -264,9 +266,9 @@ void close_sensitivities(RunContext& c) {
     columns.push_back({{"name", c.result.sensitivity_columns[k]}, {"unit", c.result.sensitivity_units[k]}});
   json j;
   j["method"] = "IDAS forward sensitivities (staggered corrector on the run's Newton matrix; sensitivities in the "
-                "local error test, their tolerances at least 1e-9 of the state's size); F_y from the formulation's "
-                "Newton matrix, F_p, consistent initial values and sensors by central differences over twin models "
-                "at p +- d (docs/sensitivities.md)";
+                "local error test, their tolerances at least 1e-9 of the state's size); F_y s, F_p, consistent initial "
+                "values and sensors by central differences over twin models at p +- d, F_y from the formulation's "
+                "Newton matrix where the differences fail (docs/sensitivities.md)";
   j["parameters"] = params;
   j["columns"] = columns;
   j["rows"] = c.result.sensitivities.empty() ? 0 : c.result.sensitivities[0].size();
