@@ -12,6 +12,7 @@
 #include <ctime>
 #include <numeric>
 #include <sstream>
+#include <utility>
 
 #include "core/errors.h"
 #include "core/finite_check.h"
@@ -253,6 +254,8 @@ struct IdaRun {
   // between IDAS calls) and of a sample's interpolated ones; their data pointers.
   int ns = 0;
   bool sens_on = false;  // false once IDA failed with them (drop_sensitivities)
+  bool s_at_prev = false;  // r.s, r.sp hold the sensitivities at t_prev (step_onto_root set them)
+  bool go_on = false;      // step_onto_root failed with the sensitivities, and the run goes on
   N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
   std::vector<double*> s_data, sp_data, ss_data, sps_data;
   std::vector<double> pbar;
@@ -427,6 +430,7 @@ bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) 
 // there, or, before any step since the last (re)initialization, the values it was given (they
 // are still in r.s, r.sp). False (the run not failed) if IDAS cannot give them.
 bool sensitivities_at_last_step(IdaRun& r) {
+  if (r.s_at_prev) return true;
   long steps = 0;
   if (IDAGetNumSteps(r.mem, &steps) != IDA_SUCCESS) return false;
   for (int i = 0; steps > 0 && i < r.ns; ++i)
@@ -533,6 +537,8 @@ void finish_past_end(IdaRun& r, int flag, double tret) {
 // The state IDA returns at a root is interpolated, and the interpolated velocities are not
 // error-controlled at index 3. Step back to the last accepted step and integrate again with the
 // root time as stop time, so that the state at the root is a converged step. False: the run ends.
+bool drop_sensitivities(IdaRun& r, int flag);
+
 bool step_onto_root(IdaRun& r, double t_root) {
   const double h_default = r.ud.h_initial;
   choose_initial_step(r, r.t_prev);
@@ -544,6 +550,7 @@ bool step_onto_root(IdaRun& r, double t_root) {
       fail(r, "integration_failed", "the sensitivities at t = " + std::to_string(r.t_prev) + " cannot be had", r.t_prev);
       return false;
     }
+    r.s_at_prev = r.sens_on;
     std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
     std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
     check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
@@ -566,6 +573,10 @@ bool step_onto_root(IdaRun& r, double t_root) {
   check(IDARootInit(r.mem, r.nsw, root_fn), "IDARootInit");
   r.ud.h_initial = h_default;
   check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
+  if (flag < 0 && r.sens_on && r.stats.ok) {  // the sensitivities' failure: on from t_prev (advance)
+    r.go_on = drop_sensitivities(r, flag);
+    return false;
+  }
   if (flag < 0) ida_failure(r, flag);
   if (!r.stats.ok) return false;
   r.stats.event_times.push_back(r.t);
@@ -671,13 +682,14 @@ bool advance(IdaRun& r) {
     check(IDAGetRootInfo(r.mem, r.roots.data()), "IDAGetRootInfo");
     // A root that changes no mode (a switching function grazing zero) needs no restart.
     if (!r.problem->changes_mode(tret, data(r.y), r.roots.data())) return true;
-    if (!step_onto_root(r, tret)) return false;
+    if (!step_onto_root(r, tret)) return std::exchange(r.go_on, false);
   } else {
     r.t = tret;
     r.problem->after_step(r.t, data(r.y));
     emit_until(r, r.t);
     if (!r.stats.ok) return false;
     keep_step(r);
+    r.s_at_prev = false;
     if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) return true;
     if (r.t >= o.t1) return false;
     r.stats.breakpoint_times.push_back(r.t);
