@@ -311,6 +311,67 @@ void note_rounding_floor(RunContext& c, const std::string& formulation, double r
   if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
 }
 
+// The step's formulation: the run option's, else the step's. With sensitivities a scene's index3
+// step runs as index2-ggl, and says so (a formulation asked by name is refused before the run;
+// docs/sensitivities.md), except a kinematic step whose sensitivities need no integration.
+std::string step_formulation(const RunContext& c, const AnalysisStep& step, json& js) {
+  const std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+  if (!c.sensitivities || !c.sensitivities->active || kinematic_by_ift(c, step) || sensitivity_formulation(name))
+    return name;
+  js["formulation_with_sensitivities"] = "index2-ggl instead of the scene's " + name + ": " + kIndex3SensitivityNote;
+  return "index2-ggl";
+}
+
+// The step's sensitivities, when asked: integrated with the run (IDAS, io) or, for a kinematic
+// step that allows it, by the implicit function theorem at each written row (the sampler).
+struct StepSensitivities {
+  std::unique_ptr<TwinSensitivities> integrated;
+  std::unique_ptr<KinematicSensitivities> kinematic;
+};
+
+StepSensitivities attach_sensitivities(RunContext& c, const AnalysisStep& step, MultibodyDae& dae,
+                                       const Formulation& f, const FormulationParameters& fp, const StepTolerances& tol,
+                                       IdaOptions& io, Sampler& sampler, json& js) {
+  StepSensitivities out;
+  if (kinematic_by_ift(c, step)) {
+    out.kinematic = kinematic_sensitivities(c, step);
+    KinematicSensitivities* ks = out.kinematic.get();
+    sampler.after_row = [&c, ks, &dae, &sampler](double t) {
+      record_kinematic_sample(c, *ks, dae.state().modes, &dae.state().turns, t, sampler.qo.data(), sampler.vo.data());
+    };
+    js["sensitivity_method"] = "implicit function theorem at each sample (formulation/kinematic_sensitivities.h)";
+    return out;
+  }
+  out.integrated = twin_sensitivities(c, step, dae, f, fp, tol);
+  if (TwinSensitivities* ts = out.integrated.get()) {
+    io.sensitivities = ts;
+    const bool project = step.output_projection;
+    io.sensitivity_output = [&c, ts, project](double t, const double* yy, const double* yyp, const double* const* s,
+                                               const double* const* sp) {
+      record_sensitivity_sample(c, *ts, t, yy, yyp, s, sp, project);
+    };
+  }
+  return out;
+}
+
+// The step's events, breakpoints, reach, quiet sensors (summary.json) and the verbose line.
+void describe_step(const RunContext& c, const AnalysisStep& step, const IdaStats& st, const MultibodyDae& dae,
+                   const Sampler& sampler, json& js) {
+  js["event_times"] = st.event_times;
+  js["breakpoint_times"] = st.breakpoint_times;
+  js["t_reached"] = st.t_reached;
+  if (!sampler.quiet.empty()) {
+    json qj;
+    for (size_t k = 0; k < sampler.quiet.size(); ++k) qj[c.system->sensors[sampler.quiet[k]].name] = sampler.quiet_max[k];
+    js["max_change_before"] = {{"time", step.quiet_until}, {"sensors", qj}};
+  }
+  if (c.options.verbose)
+    std::printf("%s: %ld steps, %ld residual evaluations, %ld KLU factorizations, %zu events, "
+                "cpu %.3f s, max constraint violation %.2e\n",
+                js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
+                st.event_times.size(), st.cpu_seconds, dae.state().statistics.max_position_violation);
+}
+
 json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler& s, long rows) {
   json stats;
   stats["steps"] = st.steps;
@@ -333,6 +394,7 @@ json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler&
     stats["max_constraint_condition_time"] = dae.state().statistics.max_condition_time;
   }
   stats["output_rows"] = rows;
+  stats["rounding_floor_fraction"] = dae.rounding_floor_fraction();
   return stats;
 }
 
@@ -359,14 +421,7 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
 bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
   js["type"] = analysis_type(step.type).name;
-  std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
-  const bool by_ift = kinematic_by_ift(c, step);
-  if (c.sensitivities && c.sensitivities->active && !by_ift && !sensitivity_formulation(name)) {
-    // The scene's index3 (a formulation asked by name is refused before the run): the step runs
-    // as index2-ggl, and says so (docs/sensitivities.md).
-    js["formulation_with_sensitivities"] = "index2-ggl instead of the scene's " + name + ": " + kIndex3SensitivityNote;
-    name = "index2-ggl";
-  }
+  const std::string name = step_formulation(c, step, js);
   const Formulation* f = find_formulation(name);
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");
@@ -391,21 +446,8 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   }
   SetAsideWatch watch(c, tol, io.rtol);
   Sampler sampler(c, step, *dae, watch, io.output_step);
-  const std::unique_ptr<TwinSensitivities> ts = by_ift ? nullptr : twin_sensitivities(c, step, *dae, *f, fp, tol);
-  const std::unique_ptr<KinematicSensitivities> ks = by_ift ? kinematic_sensitivities(c, step) : nullptr;
-  if (ks) {
-    sampler.after_row = [&](double t) {
-      record_kinematic_sample(c, *ks, dae->state().modes, &dae->state().turns, t, sampler.qo.data(), sampler.vo.data());
-    };
-    js["sensitivity_method"] = "implicit function theorem at each sample (formulation/kinematic_sensitivities.h)";
-  }
-  if (ts) {
-    io.sensitivities = ts.get();
-    io.sensitivity_output = [&](double t, const double* yy, const double* yyp, const double* const* s,
-                                const double* const* sp) {
-      record_sensitivity_sample(c, *ts, t, yy, yyp, s, sp, step.output_projection);
-    };
-  }
+  const StepSensitivities sens = attach_sensitivities(c, step, *dae, *f, fp, tol, io, sampler, js);
+  const TwinSensitivities* ts = sens.integrated.get();
   const size_t rows_before = c.result.rows();
   const IdaStats st = f->integrator(*dae, io, y, yp, [&](double t, const double* yy, const double* yyp) { return sampler(t, yy, yyp); });
   if (sampler.printed) std::fprintf(stderr, "\n");
@@ -414,22 +456,9 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   js["statistics"] = statistics_json(st, *dae, sampler, static_cast<long>(c.result.rows() - rows_before));
   if (ts) sensitivity_statistics(c, st, js["statistics"]);
   if (!st.sensitivity_failure.empty()) sensitivities_failed(c, "integration_failed", st.sensitivity_failure);
-  js["statistics"]["rounding_floor_fraction"] = dae->rounding_floor_fraction();
   note_rounding_floor(c, name, io.rtol, dae->rounding_floor_fraction(), js);
   follow_integration_stage(c);
-  js["event_times"] = st.event_times;
-  js["breakpoint_times"] = st.breakpoint_times;
-  js["t_reached"] = st.t_reached;
-  if (!sampler.quiet.empty()) {
-    json qj;
-    for (size_t k = 0; k < sampler.quiet.size(); ++k) qj[sys.sensors[sampler.quiet[k]].name] = sampler.quiet_max[k];
-    js["max_change_before"] = {{"time", step.quiet_until}, {"sensors", qj}};
-  }
-  if (c.options.verbose)
-    std::printf("%s: %ld steps, %ld residual evaluations, %ld KLU factorizations, %zu events, "
-                "cpu %.3f s, max constraint violation %.2e\n",
-                js["type"].get<std::string>().c_str(), st.steps, st.residual_evals, st.linear_setups,
-                st.event_times.size(), st.cpu_seconds, dae->state().statistics.max_position_violation);
+  describe_step(c, step, st, *dae, sampler, js);
   if (!dae->state().output_failure.empty()) {
     fail(c, "output_solve_failed", dae->state().output_failure, js);
     return false;
