@@ -144,3 +144,23 @@ def test_sensitivities_in_the_result_and_the_folder(tmp_path):
     assert (tmp_path / "out" / "sensitivities.csv").exists()
     assert r.summary["sensitivities"]["status"] == "ok"
     assert wheel().run().sensitivities is None
+
+
+def test_sensitivities_to_initial_values():
+    import numpy as np
+    # Released at theta0 = 0.3 with rate w0 = 10 under a constant torque: theta = theta0 + w0 t + T t^2 / (2 J),
+    # so d(theta)/d(w0) = t, d(rate)/d(w0) = 1, d(theta)/d(theta0) = 1, d(rate)/d(theta0) = 0.
+    text = WHEEL.replace("TORQUE", "2").replace("theta: {initial: 0}", "theta: {initial: 0.3}").replace(
+        "output_step: 0.01}", "output_step: 0.01, rtol: 1.0e-10, initial_velocities: {theta: 10}}")
+    text = text.replace("  - {name: angle, type: coordinate, coordinate: theta}",
+                        "  - {name: angle, type: coordinate, coordinate: theta}\n"
+                        "  - {name: rate, type: coordinate_rate, coordinate: theta}")
+    r = mbdae.Scene.from_yaml(text, "wheel.yaml").run(
+        sensitivities=["analysis.dynamics.initial_velocities.theta", "coordinates.theta.initial"])
+    s = r.sensitivities
+    t = s.index.to_numpy()
+    w0, th0 = "analysis.dynamics.initial_velocities.theta", "coordinates.theta.initial"
+    assert np.abs(s[("angle", w0)] - t).max() < 1e-7
+    assert np.abs(s[("rate", w0)] - 1).max() < 1e-6
+    assert np.abs(s[("angle", th0)] - 1).max() < 1e-6
+    assert np.abs(s[("rate", th0)]).max() < 1e-6
