@@ -99,6 +99,17 @@ struct Result {
   std::vector<std::vector<double>> row_major() const;      // every sample as a row (a copy)
 };
 
+// The sensitivities relative to the parameters' values and the sensors' scales,
+// (p / max|y|) dy/dp, max|y| each sensor's largest magnitude over the run (a pointwise (p / y)
+// dy/dp is unbounded where y crosses zero): "t", then "d(SENSOR)/d(PATH)*p/max|SENSOR|" for each
+// column of Result::sensitivities whose sensor is not zero throughout (column-major). Empty
+// without sensitivities.
+struct NormalizedSensitivities {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> data;
+};
+NormalizedSensitivities normalized_sensitivities(const Result& result);
+
 // What a sink is told before the first sample of an integration step.
 struct RunInfo {
   const Scene* scene = nullptr;

@@ -72,6 +72,10 @@ std::string read_option(const std::vector<std::string>& args, size_t& i, Command
     opt.sensitivities.push_back(args[++i]);
     return "";
   }
+  if (a == "--normalized-sensitivities") {
+    cl.normalized_sensitivities = true;
+    return "";
+  }
   if (a == "--animation") {
     cl.animation = true;
     return "";
@@ -98,6 +102,7 @@ void print_usage() {
   std::fprintf(stderr,
                "usage: mbdae run SCENE.yaml --out DIR [--rtol R] [--atol A] [--quiet] [--error-estimate]\n"
                "                  [--error-target E] [--error-sensors a,b] [--sensitivity PATH]...\n"
+               "                  [--normalized-sensitivities]\n"
                "                  [--output-step DT] [--animation] [--animation-rate HZ]\n"
                "                  [--formulation %s]\n"
                "       mbdae check SCENE.yaml\n"
@@ -128,6 +133,8 @@ std::string parse_command_line(const std::vector<std::string>& args, CommandLine
   }
   if (!cl.check_only && !cl.list_params && cl.out_dir.empty()) return "--out DIR is required";
   if (!cl.error.sensors.empty() && !(cl.error.target > 0)) return "--error-sensors: needs --error-target E";
+  if (cl.normalized_sensitivities && cl.options.sensitivities.empty())
+    return "--normalized-sensitivities: needs --sensitivity PATH";
   return "";
 }
 

@@ -30,6 +30,7 @@ struct CommandLine {
   ErrorControl error;  // --error-estimate, --error-target, --error-sensors (cases/run/error_target.h)
   bool animation = false;     // --animation: DIR/animation.pvd (cases/output/animation_sink.h)
   double animation_rate = 0;  // --animation-rate HZ (implies --animation)
+  bool normalized_sensitivities = false;  // --normalized-sensitivities: also sensitivities_normalized.csv
 };
 
 // Reads the arguments after the program name; returns "" or the usage error (exit code 1).

@@ -87,7 +87,7 @@ int run_command(int argc, char** argv) {
     mbdae::check_runnable(scene, opt);  // a scene refused here leaves the output folder as it was
     const bool animate = cl.animation || scene.animation.write;  // DIR/animation.pvd
     const mbdae::OutputRequest request{cl.out_dir, animate ? cl.out_dir : "", cl.animation_rate,
-                                       !opt.sensitivities.empty()};
+                                       !opt.sensitivities.empty(), cl.normalized_sensitivities};
     mbdae::RunSinks out = mbdae::open_sinks(scene, request);
     int tries = 0;  // an error target's later tries get fresh writers (cases/run/error_target.h)
     const mbdae::SinkFactory make_sinks = [&] {

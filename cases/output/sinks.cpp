@@ -15,17 +15,30 @@ void CsvSink::sample(const Sample& s) {
 
 void CsvSink::end(const Result&) { csv_.close(); }
 
-void SensitivityCsvSink::end(const Result& r) {
-  if (r.sensitivity_columns.empty()) return;
+namespace {
+
+// Whole columns (column-major) to PATH through CsvWriter.
+void write_columns(const std::string& path, const std::vector<std::string>& names,
+                   const std::vector<std::vector<double>>& data) {
   CsvWriter csv;
-  csv.open(path_, r.sensitivity_columns);
-  std::vector<double> row(r.sensitivity_columns.size());
-  const size_t rows = r.sensitivities.empty() ? 0 : r.sensitivities[0].size();
+  csv.open(path, names);
+  std::vector<double> row(names.size());
+  const size_t rows = data.empty() ? 0 : data[0].size();
   for (size_t i = 0; i < rows; ++i) {
-    for (size_t k = 0; k < row.size(); ++k) row[k] = r.sensitivities[k][i];
+    for (size_t k = 0; k < row.size(); ++k) row[k] = data[k][i];
     csv.row(row.data());
   }
   csv.close();
+}
+
+}  // namespace
+
+void SensitivityCsvSink::end(const Result& r) {
+  if (r.sensitivity_columns.empty()) return;
+  write_columns(path_, r.sensitivity_columns, r.sensitivities);
+  if (normalized_path_.empty()) return;
+  const NormalizedSensitivities n = normalized_sensitivities(r);
+  write_columns(normalized_path_, n.columns, n.data);
 }
 
 void SummarySink::end(const Result& result) { write_json_file(path_, result.summary); }
@@ -36,11 +49,15 @@ RunSinks open_sinks(const Scene& scene, const OutputRequest& request) {
   // is claimed or changed (cases/output/animation_sink.h).
   if (!request.animation_dir.empty()) check_animation_size(scene, request.animation_dir, request.animation_rate);
   if (!request.out_dir.empty()) {
-    s.lock = claim_output_folder(request.out_dir, {"results.csv", "summary.json", "sensitivities.csv"});
+    s.lock = claim_output_folder(request.out_dir,
+                                 {"results.csv", "summary.json", "sensitivities.csv", "sensitivities_normalized.csv"});
     // An earlier run's sensitivities, which this run does not replace.
-    const std::string old = request.out_dir + "/sensitivities.csv";
-    if (!request.sensitivities && std::remove(old.c_str()) != 0 && errno != ENOENT)
-      throw OutputError("cannot remove the previous run's " + old + ": " + std::strerror(errno));
+    for (const auto& [name, written] : {std::pair<const char*, bool>{"sensitivities.csv", request.sensitivities},
+                                        {"sensitivities_normalized.csv", request.normalized_sensitivities}}) {
+      const std::string old = request.out_dir + "/" + name;
+      if (!written && std::remove(old.c_str()) != 0 && errno != ENOENT)
+        throw OutputError("cannot remove the previous run's " + old + ": " + std::strerror(errno));
+    }
     // An earlier run's animation files, when this run writes none there.
     if (request.animation_dir != request.out_dir) remove_animation_files(request.out_dir);
   }
@@ -55,7 +72,9 @@ void renew_sinks(const Scene& scene, const OutputRequest& request, RunSinks& s) 
     s.summary = std::make_unique<SummarySink>(request.out_dir + "/summary.json");
     s.list = {s.csv.get()};
     if (request.sensitivities) {
-      s.sensitivities = std::make_unique<SensitivityCsvSink>(request.out_dir + "/sensitivities.csv");
+      s.sensitivities = std::make_unique<SensitivityCsvSink>(
+          request.out_dir + "/sensitivities.csv",
+          request.normalized_sensitivities ? request.out_dir + "/sensitivities_normalized.csv" : "");
       s.list.push_back(s.sensitivities.get());
     }
     s.list.push_back(s.summary.get());

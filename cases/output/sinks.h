@@ -29,13 +29,15 @@ class CsvSink : public Sink {
 
 // sensitivities.csv (RunOptions::sensitivities) when the run ends: Result::sensitivities, the
 // rows computed (also of a failed run), through PATH.partial like results.csv.
+// With `normalized_path`, also normalized_sensitivities() there.
 class SensitivityCsvSink : public Sink {
  public:
-  explicit SensitivityCsvSink(std::string path) : path_(std::move(path)) {}
+  SensitivityCsvSink(std::string path, std::string normalized_path)
+      : path_(std::move(path)), normalized_path_(std::move(normalized_path)) {}
   void end(const Result& result) override;
 
  private:
-  std::string path_;
+  std::string path_, normalized_path_;
 };
 
 // summary.json at the end of the run (written atomically: core/output.h write_json_file).
@@ -55,6 +57,7 @@ struct OutputRequest {
   std::string animation_dir;
   double animation_rate = 0;  // frames per second of simulated time (0: the scene's)
   bool sensitivities = false;  // out_dir/sensitivities.csv (else an earlier run's is removed)
+  bool normalized_sensitivities = false;  // also out_dir/sensitivities_normalized.csv
 };
 
 // The sinks of one run and the lock of its output folder, held until the run ends. The one

@@ -255,6 +255,28 @@ void follow_integration_stage(RunContext& c) {
   }
 }
 
+NormalizedSensitivities normalized_sensitivities(const Result& r) {
+  NormalizedSensitivities out;
+  if (r.sensitivity_columns.empty() || !r.summary.contains("sensitivities")) return out;
+  const json& params = r.summary["sensitivities"]["parameters"];
+  const size_t np = params.size();
+  out.columns = {"t"};
+  out.data = {r.sensitivities[0]};
+  for (size_t k = 1; k < r.columns.size(); ++k) {
+    double scale = 0;
+    for (double y : r.data[k]) scale = std::fmax(scale, std::fabs(y));
+    if (!(scale > 0)) continue;
+    for (size_t i = 0; i < np; ++i) {
+      const size_t col = 1 + (k - 1) * np + i;
+      const double f = params[i]["value"].get<double>() / scale;
+      out.columns.push_back(r.sensitivity_columns[col] + "*p/max|" + r.columns[k] + "|");
+      out.data.emplace_back(r.sensitivities[col]);
+      for (double& v : out.data.back()) v *= f;
+    }
+  }
+  return out;
+}
+
 void close_sensitivities(RunContext& c) {
   if (!c.sensitivities) return;
   const RunSensitivities& rs = *c.sensitivities;

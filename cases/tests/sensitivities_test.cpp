@@ -203,17 +203,26 @@ TEST_F(SensitivitiesCli, WritesTheCsvAndListsTheParametersInTheSummary) {
   EXPECT_EQ(s["parameters"][0]["value"], 2.0);
   EXPECT_EQ(s["columns"][1]["unit"], "m/kg");
   EXPECT_EQ(s["columns"][3]["unit"], "(m/s)/kg");
+  EXPECT_FALSE(std::filesystem::exists(out / "sensitivities_normalized.csv"));
+  // The normalized form on request: (p / max|y|) dy/dp, p = 2 kg.
+  r = run_command(base + " --sensitivity bodies.slider.mass --normalized-sensitivities");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string norm = read_file(out / "sensitivities_normalized.csv");
+  EXPECT_EQ(norm.substr(0, norm.find('\n')), "t,d(z)/d(bodies.slider.mass)*p/max|z|,d(vz)/d(bodies.slider.mass)*p/max|vz|");
+  EXPECT_EQ(std::count(norm.begin(), norm.end(), '\n'), 82);
   // A run without sensitivities into the same folder leaves no stale file.
   r = run_command(base);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out / "sensitivities.csv"));
+  EXPECT_FALSE(std::filesystem::exists(out / "sensitivities_normalized.csv"));
   // Bad requests: usage errors (exit 1) before the folder is touched.
   for (const std::string& bad : {std::string(" --sensitivity"), std::string(" --sensitivity bodies.slider.mas"),
                                  std::string(" --sensitivity analysis.dynamics.t_end"),
-                                 std::string(" --sensitivity bodies.slider.mass --formulation index3")}) {
+                                 std::string(" --sensitivity bodies.slider.mass --formulation index3"),
+                                 std::string(" --normalized-sensitivities")}) {
     r = run_command(base + bad);
     EXPECT_EQ(r.code, 1) << bad << ": " << r.output;
-    EXPECT_NE(r.output.find("--sensitivity"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("sensitivit"), std::string::npos) << r.output;
   }
 }
 
