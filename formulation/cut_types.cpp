@@ -94,15 +94,19 @@ void weld(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
   add_frame_alignment(cut, s, out);
 }
 
-void prismatic(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
-  add_frame_alignment(cut, s, out);
-  const Vec3 a1 = axis1(cut, s);
+// Point 2 on body 1's axis line a1: no offset along the two directions across it.
+void no_offset_across_axis(const Vec3& a1, const CutSides& s, const CutEquations& out) {
   const Vec3 m1 = a1.unitOrthogonal(), m2 = a1.cross(m1);
   for (const Vec3& m : {m1, m2}) {
     Constraint c = cut_constraint(Constraint::Type::kDot2, s);
     c.ai = m;
     out.add(c, "no offset across the axis");
   }
+}
+
+void prismatic(const CutSpec& cut, const CutSides& s, const CutEquations& out) {
+  add_frame_alignment(cut, s, out);
+  no_offset_across_axis(axis1(cut, s), s, out);
 }
 
 // Rotation about and translation along a common axis: the axes parallel (as the revolute) and
@@ -112,12 +116,7 @@ void cylindrical(const CutSpec& cut, const CutSides& s, const CutEquations& out)
   const Vec3 n1 = a2.unitOrthogonal(), n2 = a2.cross(n1);
   dot1(s, a1, n1, "axis1 _|_ n1", out);
   dot1(s, a1, n2, "axis1 _|_ n2", out);
-  const Vec3 m1 = a1.unitOrthogonal(), m2 = a1.cross(m1);
-  for (const Vec3& m : {m1, m2}) {
-    Constraint c = cut_constraint(Constraint::Type::kDot2, s);
-    c.ai = m;
-    out.add(c, "no offset across the axis");
-  }
+  no_offset_across_axis(a1, s, out);
 }
 
 void distance(const CutSpec& cut, const CutSides& s, const CutEquations& out) {

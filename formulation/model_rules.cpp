@@ -83,6 +83,15 @@ struct ModelRules : ModelNames {
     return first.file + ":" + std::to_string(first.line);
   }
   bool known_body(const std::string& b) const { return b == kGround || bodies.count(b); }
+  // Records a named item in `names`; a second item of that name is reported where it stands.
+  template <class Spec>
+  void register_name(std::map<std::string, const Spec*>& names, const Spec& item, const char* kind) {
+    if (item.name.empty()) return;
+    auto [it, fresh] = names.emplace(item.name, &item);
+    if (!fresh)
+      report(item.where, "name", std::string(kind) + " '" + item.name + "' is defined twice (first at " +
+                                     at(it->second->where, item.where) + ")");
+  }
   std::vector<std::string> body_names() const {
     std::vector<std::string> v = {kGround};
     for (const auto& [n, b] : bodies) v.push_back(n);
@@ -139,9 +148,7 @@ struct ModelRules : ModelNames {
         report(b.where, "name", "'ground' is reserved for the fixed frame; name the body differently");
         continue;
       }
-      auto [it, fresh] = bodies.emplace(b.name, &b);
-      if (!fresh)
-        report(b.where, "name", "body '" + b.name + "' is defined twice (first at " + at(it->second->where, b.where) + ")");
+      register_name(bodies, b, "body");
     }
   }
 
@@ -153,11 +160,7 @@ struct ModelRules : ModelNames {
     std::map<std::string, const JointSpec*> names;
     for (const auto& j : m.joints) {
       const std::string who = "joint '" + j.name + "': ";
-      if (!j.name.empty()) {
-        auto [it, fresh] = names.emplace(j.name, &j);
-        if (!fresh)
-          report(j.where, "name", "joint '" + j.name + "' is defined twice (first at " + at(it->second->where, j.where) + ")");
-      }
+      register_name(names, j, "joint");
       if (!j.parent.empty() && !known_body(j.parent)) report(j.where, "parent", who + no_body(j.parent));
       if (!j.child.empty()) {
         if (j.child == kGround) {
@@ -309,11 +312,7 @@ struct ModelRules : ModelNames {
     std::map<std::string, const CutSpec*> names;
     for (const auto& c : m.cuts) {
       const std::string who = "cut '" + c.name + "': ";
-      if (!c.name.empty()) {
-        auto [it, fresh] = names.emplace(c.name, &c);
-        if (!fresh)
-          report(c.where, "name", "cut '" + c.name + "' is defined twice (first at " + at(it->second->where, c.where) + ")");
-      }
+      register_name(names, c, "cut");
       check_point(c.where, who, "body1", c.body1, "point1", c.point1);
       check_point(c.where, who, "body2", c.body2, "point2", c.point2);
       if (cut_type(c.type).frames) {
@@ -332,11 +331,7 @@ struct ModelRules : ModelNames {
   void check_forces() {
     for (const auto& f : m.forces) {
       const std::string who = "force '" + f.name + "': ";
-      if (!f.name.empty()) {
-        auto [it, fresh] = forces.emplace(f.name, &f);
-        if (!fresh)
-          report(f.where, "name", "force '" + f.name + "' is defined twice (first at " + at(it->second->where, f.where) + ")");
-      }
+      register_name(forces, f, "force");
       switch (force_type(f.type).attach) {  // the references of its row's attachment
         case ForceAttach::kTwoPoints:
           check_point(f.where, who, "body1", f.body1, "point1", f.point1);
