@@ -157,11 +157,8 @@ std::vector<std::string> run_option_errors(const Scene& scene, const RunOptions&
       out.push_back("formulation: expected one of " + list + ", got '" + opt.formulation + "'");
     }
   }
-  for (std::string& m : check_sensitivity_paths(scene, opt.sensitivities, "sensitivities")) out.push_back(std::move(m));
-  if (!opt.sensitivities.empty() && !opt.formulation.empty() && !sensitivity_formulation(opt.formulation))
-    out.push_back("sensitivities: not with formulation " + opt.formulation + " (" + kIndex3SensitivityNote +
-                  "); use index2-ggl, index1 or penalty, or leave the scene's formulation (its index3 steps then run as "
-                  "index2-ggl)");
+  for (std::string& m : check_sensitivity_paths(scene, opt.sensitivities, opt.formulation, "sensitivities"))
+    out.push_back(std::move(m));
   if (out.empty())
     for (const std::string& m : check_overrides(scene, opt)) out.push_back("output_step" + m.substr(m.find(':')));
   return out;
@@ -180,11 +177,8 @@ std::vector<std::string> check_overrides(const Scene& scene, const RunOptions& o
 
 std::vector<std::string> check_overrides(const Scene& scene, const CommandLine& cl) {
   std::vector<std::string> out = check_error_sensors(scene, cl.error.sensors, "--error-sensors");
-  for (std::string& m : check_sensitivity_paths(scene, cl.options.sensitivities, "--sensitivity")) out.push_back(std::move(m));
-  if (!cl.options.sensitivities.empty() && !cl.options.formulation.empty() && !sensitivity_formulation(cl.options.formulation))
-    out.push_back("--sensitivity: not with --formulation " + cl.options.formulation + " (" + kIndex3SensitivityNote +
-                  "); use index2-ggl, index1 or penalty, or leave the scene's formulation (its index3 steps then run as "
-                  "index2-ggl)");
+  for (std::string& m : check_sensitivity_paths(scene, cl.options.sensitivities, cl.options.formulation, "--sensitivity"))
+    out.push_back(std::move(m));
   for (std::string& m : check_overrides(scene, cl.options)) out.push_back(std::move(m));
   return out;
 }

@@ -9,6 +9,7 @@
 
 #include "cases/run/run_stages.h"
 #include "cases/scene/analysis_types.h"
+#include "cases/scene/field_ranges.h"  // parse_number
 #include "core/errors.h"
 #include "core/finite_check.h"
 #include "formulation/mechanics.h"  // initial_modes
@@ -20,12 +21,6 @@ namespace mbdae {
 namespace {
 
 using json = nlohmann::ordered_json;
-
-bool read_number(const std::string& text, double& v) {
-  char* end = nullptr;
-  v = std::strtod(text.c_str(), &end);
-  return !text.empty() && end && *end == '\0' && std::isfinite(v);
-}
 
 // Analysis settings are not parameters of the model, except the initial rates of joints.
 bool analysis_setting(const std::string& path) {
@@ -81,16 +76,21 @@ const char* const kIndex3SensitivityNote =
     "index3-positions diverges; index2-ggl 6e-7 at the same rtol 1e-8), and in the test the difference noise of "
     "F_p stops the steps at index3's rounding-level tolerances (docs/sensitivities.md)";
 
-std::vector<std::string> check_sensitivity_paths(const Scene& scene, const std::vector<std::string>& paths,
-                                                 const std::string& option) {
-  std::vector<std::string> out;
-  if (paths.empty()) return out;
-  std::vector<ParameterEntry> entries;
+namespace {
+
+// The scene's parameter list, or the message why it has none (a scene built in code).
+std::vector<ParameterEntry> entries_or_problem(const Scene& scene, const std::string& option, std::string& problem) {
   try {
-    entries = scene_parameters(scene);
+    return scene_parameters(scene);
   } catch (const SceneError& e) {
-    return {option + ": " + (e.messages.empty() ? std::string(e.what()) : e.messages.front())};
+    problem = option + ": " + (e.messages.empty() ? std::string(e.what()) : e.messages.front());
+    return {};
   }
+}
+
+std::vector<std::string> path_problems(const std::vector<ParameterEntry>& entries, const std::vector<std::string>& paths,
+                                       const std::string& formulation, const std::string& option) {
+  std::vector<std::string> out;
   std::vector<std::string> names;
   for (const ParameterEntry& e : entries) names.push_back(e.path);
   for (size_t i = 0; i < paths.size(); ++i) {
@@ -104,28 +104,43 @@ std::vector<std::string> check_sensitivity_paths(const Scene& scene, const std::
       out.push_back(head + "no such parameter (`mbdae params SCENE` lists them)" + did_you_mean(path, names));
     else if (analysis_setting(path))
       out.push_back(head + "a setting of the analysis, not a parameter of the model: it cannot be differentiated");
-    else if (!read_number(it->value, v))
+    else if (!parse_number(it->value, v))
       out.push_back(head + "names '" + it->value + "' (" + it->file + ":" + std::to_string(it->line) +
                     "), not a single number" + (it->value.rfind('[', 0) == 0 ? "; name one element: " + path + ".0" : ""));
   }
+  if (!formulation.empty() && !sensitivity_formulation(formulation))
+    out.push_back(option + ": not with formulation " + formulation + " (" + kIndex3SensitivityNote +
+                  "); use index2-ggl, index1 or penalty, or leave the scene's formulation (its index3 steps then run "
+                  "as index2-ggl)");
   return out;
+}
+
+}  // namespace
+
+std::vector<std::string> check_sensitivity_paths(const Scene& scene, const std::vector<std::string>& paths,
+                                                 const std::string& formulation, const std::string& option) {
+  if (paths.empty()) return {};
+  std::string problem;
+  const std::vector<ParameterEntry> entries = entries_or_problem(scene, option, problem);
+  if (!problem.empty()) return {problem};
+  return path_problems(entries, paths, formulation, option);
 }
 
 std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c) {
   const std::vector<std::string>& paths = c.options.sensitivities;
   if (paths.empty()) return nullptr;
-  std::vector<std::string> problems = check_sensitivity_paths(c.scene, paths, "sensitivities");
-  if (!c.options.formulation.empty() && !sensitivity_formulation(c.options.formulation))
-    problems.push_back("sensitivities: not with formulation " + c.options.formulation + " (" + kIndex3SensitivityNote + ")");
+  std::string problem;
+  const std::vector<ParameterEntry> entries = entries_or_problem(c.scene, "sensitivities", problem);
+  const std::vector<std::string> problems =
+      problem.empty() ? path_problems(entries, paths, c.options.formulation, "sensitivities") : std::vector{problem};
   if (!problems.empty()) throw ModelError(c.scene.file, 0, "sensitivities", problems.front());
-  const std::vector<ParameterEntry> entries = scene_parameters(c.scene);
   auto rs = std::make_shared<RunSensitivities>();
   for (const std::string& path : paths) {
     const ParameterEntry& e = *std::find_if(entries.begin(), entries.end(), [&](const ParameterEntry& x) { return x.path == path; });
     SensitivityParameter p;
     p.path = path;
     p.unit = e.unit;
-    read_number(e.value, p.value);
+    parse_number(e.value, p.value);
     p.scale = p.value != 0 ? std::fabs(p.value) : 1.0;
     p.delta = kRelativeStep * p.scale;
     p.twin[0] = make_twin(c, p, p.value + p.delta);

@@ -64,9 +64,10 @@ extern const char* const kIndex3SensitivityNote;
 
 // Problems with the requested paths, each message starting with `option`: an unknown path (with
 // a "did you mean"), a path that names no single number, an analysis setting (rtol, t_end, ...:
-// not a parameter of the model), a path asked twice.
+// not a parameter of the model), a path asked twice; and `formulation`, the one asked by name
+// (empty: the scene's), if its sensitivities cannot be integrated.
 std::vector<std::string> check_sensitivity_paths(const Scene& scene, const std::vector<std::string>& paths,
-                                                 const std::string& option);
+                                                 const std::string& formulation, const std::string& option);
 
 // The parameters of c.options.sensitivities and their twins, built as the run's System was.
 // Throws ModelError when a twin's model has other coordinates or equations (a parameter that

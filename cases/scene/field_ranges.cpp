@@ -1,5 +1,7 @@
 #include "cases/scene/field_ranges.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 namespace mbdae {
@@ -8,6 +10,12 @@ std::string format_number(double x) {
   std::ostringstream os;
   os << x;
   return os.str();
+}
+
+bool parse_number(const std::string& text, double& v) {
+  char* end = nullptr;
+  v = std::strtod(text.c_str(), &end);
+  return !text.empty() && end && *end == '\0' && std::isfinite(v);
 }
 
 std::string rtol_range_error(double rtol) {

@@ -10,6 +10,8 @@ namespace mbdae {
 constexpr double kMaxOutputRows = 1e8;  // output_step may not ask for more rows than this
 
 std::string format_number(double x);  // as in messages: shortest of %g-like text (1e-300, 0.5)
+// A number as the scene loader reads one: all of `text`, finite. False otherwise.
+bool parse_number(const std::string& text, double& v);
 std::string rtol_range_error(double rtol);
 std::string atol_range_error(double atol);
 // Positive, and at most kMaxOutputRows samples over [t0, t_end] (a span that is not valid is
