@@ -583,6 +583,25 @@ bool step_onto_root(IdaRun& r, double t_root) {
   return true;
 }
 
+// IDA anew at r.t from (y, y') (after a restart or a retry): the first step chosen again, then on
+// to the next stop.
+void start_again(IdaRun& r) {
+  choose_initial_step(r, r.t);
+  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
+  reinit(r, r.t);
+  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+}
+
+// Back to the last accepted step's state (keep_step), the failure of IDA's callbacks forgotten.
+void back_to_last_step(IdaRun& r) {
+  r.ud.callback_error.clear();
+  r.ud.callback_status.clear();
+  r.ud.non_finite = -1;
+  std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
+  std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
+  r.t = r.t_prev;
+}
+
 // After an event (roots: which functions crossed) or a breakpoint (roots null): the problem's
 // restart (new modes, a consistent state), then IDA anew from there. False: the run ends.
 bool restart(IdaRun& r, const int* roots) {
@@ -601,10 +620,7 @@ bool restart(IdaRun& r, const int* roots) {
   }
   if (!finite(r, data(r.y), r.t, "") || !finite(r, data(r.yp), r.t, "derivative of ")) return false;
   ++r.stats.restarts;
-  choose_initial_step(r, r.t);
-  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
-  reinit(r, r.t);
-  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+  start_again(r);
   keep_step(r);
   return true;
 }
@@ -613,22 +629,14 @@ bool restart(IdaRun& r, const int* roots) {
 // interpolant), made consistent by the problem, and IDA anew. False if that cannot be done.
 bool retry_sensitivities(IdaRun& r) {
   if (!sensitivities_at_last_step(r)) return false;
-  r.ud.callback_error.clear();
-  r.ud.callback_status.clear();
-  r.ud.non_finite = -1;
-  std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
-  std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
-  r.t = r.t_prev;
+  back_to_last_step(r);
   try {
     r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
   } catch (const SolveError&) {
     return false;
   }
   r.stats.sensitivity_fallback_time = r.t;
-  choose_initial_step(r, r.t);
-  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
-  reinit(r, r.t);
-  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+  start_again(r);
   return true;
 }
 
@@ -644,18 +652,10 @@ bool drop_sensitivities(IdaRun& r, int flag) {
   if (!r.ud.callback_error.empty()) os << ": " << r.ud.callback_error;
   os << "; the run went on without them from t = " << r.t_prev;
   r.stats.sensitivity_failure = os.str();
-  r.ud.callback_error.clear();
-  r.ud.callback_status.clear();
-  r.ud.non_finite = -1;
   check(IDASensToggleOff(r.mem), "IDASensToggleOff");
   r.sens_on = false;
-  std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
-  std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
-  r.t = r.t_prev;
-  choose_initial_step(r, r.t);
-  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
-  reinit(r, r.t);
-  check(IDASetStopTime(r.mem, next_stop(r)), "IDASetStopTime");
+  back_to_last_step(r);
+  start_again(r);
   return true;
 }
 
