@@ -1,9 +1,5 @@
 #include "core/ida_driver.h"
 
-#include <idas/idas.h>
-#include <nvector/nvector_serial.h>
-#include <sunmatrix/sunmatrix_sparse.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -16,11 +12,12 @@
 
 #include "core/errors.h"
 #include "core/finite_check.h"
+#include "core/ida_run.h"
 #include "core/reduced_linear_solver.h"
 #include "core/sundials_compat.h"
 
 namespace mbdae {
-namespace {
+namespace ida_detail {
 
 // The calling thread's CPU clock: a run's cpu_seconds is its own cost even when other runs (or
 // Python threads) use the process's other cores at the same time.
@@ -28,52 +25,6 @@ double cpu_now() {
   timespec ts;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-struct UserData {
-  DaeProblem* problem;
-  const CscPattern* pattern;
-  void* mem;
-  double rtol, atol, h_initial;
-  std::string last_ida_error;  // IDA's own words about its last error (not printed)
-  std::string callback_error;  // an exception of the problem's residual or Jacobian
-  std::string callback_status;  // a SolveError's status (a load that is not finite), else empty
-  int non_finite = -1;         // a component of y found not finite by weights_fn
-  double non_finite_value = 0;
-  SensitivityProblem* sens = nullptr;  // IdaOptions::sensitivities
-  N_Vector state_weights = nullptr;    // the state's weight vector (IDA's first weights_fn call)
-  const double* id = nullptr;          // the error test's mask
-  double state_size = 0;               // max |y_i| over the error-tested components, at the last state weights
-  std::vector<double> state_y;         // the state at the last state weights
-  std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
-  std::vector<double*> r_out;
-};
-
-// With sensitivities, IDAS calls weights_fn for the state (first, and always with the same
-// weight vector) and for each sensitivity at pbar_i s_i. The sensitivities' tolerances never go
-// below kSensitivityNoise times the state's size (or the component's own, where larger: the
-// multipliers, in newtons): their residual's parameter derivative is a
-// difference over twin models (formulation/twin_sensitivities.h) whose rounding is about 1e5 eps
-// of the state, above the rounding-level floors of the state's own weights (measured: index2-ggl
-// on A01 at rtol 1e-8 stopped at its first step without this floor).
-constexpr double kSensitivityNoise = 1e-9;
-
-void sensitivity_weight_floor(UserData* u, N_Vector y, N_Vector w) {
-  const int n = u->problem->size();
-  if (!u->state_weights) u->state_weights = w;
-  double* wd = N_VGetArrayPointer(w);
-  if (w == u->state_weights) {
-    const double* yd = N_VGetArrayPointer(y);
-    u->state_size = 0;
-    for (int i = 0; i < n; ++i)
-      if (u->id[i] > 0) u->state_size = std::fmax(u->state_size, std::fabs(yd[i]));
-    u->state_y.assign(yd, yd + n);  // sized once: no allocation after the first call
-    return;
-  }
-  for (int i = 0; i < n && !u->state_y.empty(); ++i) {
-    const double floor = kSensitivityNoise * std::fmax(u->state_size, std::fabs(u->state_y[i]));
-    if (floor > 0 && wd[i] * floor > 1) wd[i] = 1 / floor;
-  }
 }
 
 int weights_fn(N_Vector y, N_Vector w, void* ud) {
@@ -100,20 +51,6 @@ int weights_fn(N_Vector y, N_Vector w, void* ud) {
   u->problem->error_weights(1e-3 * h, N_VGetArrayPointer(y), u->rtol, u->atol, N_VGetArrayPointer(w));
   if (u->sens) sensitivity_weight_floor(u, y, w);
   return 0;
-}
-
-// No C++ exception may cross IDA's C frames: one from the problem's residual or Jacobian (a bug,
-// such as an assembly that does not repeat its pattern) is kept and IDA stopped (return -1).
-int callback_failed(UserData* u, const char* where, const std::exception& e) {
-  u->callback_error = std::string(where) + ": " + e.what();
-  return -1;
-}
-// A SolveError of the problem (a load that is not finite, formulation/sensors.cpp) ends the run
-// with its own status and message.
-int callback_solve_error(UserData* u, const SolveError& e) {
-  u->callback_status = e.status;
-  u->callback_error = e.what();
-  return -1;
 }
 
 int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
@@ -146,39 +83,9 @@ int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector
   }
 }
 
-// The sensitivity equations' residual (IdaOptions::sensitivities), for every parameter at once.
-int sensitivity_residual_fn(int ns, sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, N_Vector* s, N_Vector* sp,
-                            N_Vector* rs, void* ud, N_Vector, N_Vector, N_Vector) {
-  auto* u = static_cast<UserData*>(ud);
-  for (int i = 0; i < ns; ++i) {
-    u->s_in[i] = N_VGetArrayPointer(s[i]);
-    u->sp_in[i] = N_VGetArrayPointer(sp[i]);
-    u->r_out[i] = N_VGetArrayPointer(rs[i]);
-  }
-  try {
-    return u->sens->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r), u->s_in.data(),
-                             u->sp_in.data(), u->r_out.data());
-  } catch (const SolveError& e) {
-    return callback_solve_error(u, e);
-  } catch (const std::exception& e) {
-    return callback_failed(u, "sensitivity residual", e);
-  }
-}
-
 int root_fn(sunrealtype t, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
   static_cast<UserData*>(ud)->problem->switches(t, N_VGetArrayPointer(y), g);
   return 0;
-}
-
-// Every SUNDIALS call that returns a flag goes through check: a negative flag (a setting IDA
-// refused, memory it could not get) ends the run as an internal error naming the call.
-void check(int flag, const char* call) {
-  if (flag < 0) throw SolveError("internal_error", std::string(call) + " failed (" + ida_flag_name(flag) + ")");
-}
-template <class T>
-T check(T made, const char* call) {
-  if (!made) throw SolveError("internal_error", std::string(call) + " returned nothing (out of memory?)");
-  return made;
 }
 
 // IDA's counters restart at every IDAReInit: add them up before each one.
@@ -222,67 +129,6 @@ std::string worst_components(void* mem, DaeProblem& p, N_Vector tmp1, N_Vector t
   return os.str();
 }
 
-// One integration: the SUNDIALS objects, the segment and sample bookkeeping, the statistics.
-// Built by open_run, advanced by the stages below; the destructor frees the SUNDIALS objects.
-struct IdaRun {
-  DaeProblem* problem = nullptr;
-  const IdaOptions* o = nullptr;
-  const std::function<bool(double, const double*, const double*)>* output = nullptr;
-  int n = 0;
-  SUNContext ctx = nullptr;
-  N_Vector y = nullptr, yp = nullptr, id = nullptr, ys = nullptr, yps = nullptr;
-  SUNMatrix jac = nullptr;
-  SUNLinearSolver ls = nullptr;
-  void* mem = nullptr;
-  UserData ud{};
-  double h_cap = 0;  // the first step never exceeds the default one
-  int nsw = 0;       // switching functions
-  std::vector<int> roots;
-  std::vector<double> bps;  // breakpoints inside the span, sorted
-  bool end_is_breakpoint = false;
-  size_t next_bp = 0;
-  long sample_index = 0;  // the next output sample; -1 once the last is emitted
-  bool stop_requested = false;
-  bool with_derivative = false;
-  double t = 0, t_prev = 0;  // the current time and that of the last accepted step
-  std::vector<double> y_prev, yp_prev;
-  IdaStats stats;
-  long watch_steps = 0;  // steps since watch_t (the step budget, IdaOptions::max_total_steps)
-  double watch_t = 0;
-  int watch_strikes = 0;  // windows in a row whose rate projects more than the budget
-  // Sensitivities (IdaOptions::sensitivities): ns vectors each of s and s' (the state's, kept
-  // between IDAS calls) and of a sample's interpolated ones; their data pointers.
-  int ns = 0;
-  bool sens_on = false;  // false once IDA failed with them (drop_sensitivities)
-  bool s_at_prev = false;  // r.s, r.sp hold the sensitivities at t_prev (step_onto_root set them)
-  bool go_on = false;      // step_onto_root failed with the sensitivities, and the run goes on
-  N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
-  std::vector<double*> s_data, sp_data, ss_data, sps_data;
-  std::vector<double> pbar;
-
-  IdaRun() = default;
-  IdaRun(const IdaRun&) = delete;
-  IdaRun& operator=(const IdaRun&) = delete;
-  ~IdaRun() {
-    if (mem) IDAFree(&mem);
-    if (ls) SUNLinSolFree(ls);
-    if (jac) SUNMatDestroy(jac);
-    for (N_Vector v : {y, yp, id, ys, yps})
-      if (v) N_VDestroy(v);
-    for (N_Vector* v : {s, sp, ss, sps})
-      if (v) N_VDestroyVectorArray(v, ns);
-    if (ctx) SUNContext_Free(&ctx);
-  }
-};
-
-double* data(N_Vector v) { return N_VGetArrayPointer(v); }
-
-std::vector<double*> data(N_Vector* v, int n) {
-  std::vector<double*> out(n);
-  for (int i = 0; i < n; ++i) out[i] = data(v[i]);
-  return out;
-}
-
 void choose_initial_step(IdaRun& r, double tt) {
   if (r.o->initial_step > 0) return;
   const double h = r.problem->initial_step(tt, data(r.y), data(r.yp), r.o->rtol, r.o->atol);
@@ -315,33 +161,6 @@ void configure_ida(IdaRun& r) {
     check(IDASetNoInactiveRootWarn(r.mem), "IDASetNoInactiveRootWarn");
   }
   r.roots.assign(std::max(1, r.nsw), 0);
-}
-
-// IDAS's forward sensitivities (IdaOptions::sensitivities): consistent initial values from the
-// problem; the staggered corrector (the sensitivities' Newton iterations after the state's, on
-// its Newton matrix); error weights those of the state at pbar_i s_i (IDASensEEtolerances).
-void open_sensitivities(IdaRun& r) {
-  SensitivityProblem* sp = r.o->sensitivities;
-  if (!sp) return;
-  r.ns = sp->count();
-  for (N_Vector** v : {&r.s, &r.sp, &r.ss, &r.sps}) *v = check(N_VCloneVectorArray(r.ns, r.y), "N_VCloneVectorArray");
-  r.s_data = data(r.s, r.ns);
-  r.sp_data = data(r.sp, r.ns);
-  r.ss_data = data(r.ss, r.ns);
-  r.sps_data = data(r.sps, r.ns);
-  r.ud.sens = sp;
-  r.ud.id = data(r.id);
-  r.ud.s_in.resize(r.ns);
-  r.ud.sp_in.resize(r.ns);
-  r.ud.r_out.resize(r.ns);
-  sp->initial(r.o->t0, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
-  check(IDASensInit(r.mem, r.ns, IDA_STAGGERED, sensitivity_residual_fn, r.s, r.sp), "IDASensInit");
-  check(IDASensEEtolerances(r.mem), "IDASensEEtolerances");
-  r.pbar.resize(r.ns);
-  for (int i = 0; i < r.ns; ++i) r.pbar[i] = sp->scale(i);
-  check(IDASetSensParams(r.mem, nullptr, r.pbar.data(), nullptr), "IDASetSensParams");
-  check(IDASetSensErrCon(r.mem, sp->in_error_test() ? SUNTRUE : SUNFALSE), "IDASetSensErrCon");
-  r.sens_on = true;
 }
 
 // Breakpoints inside the span end segments. One at t1 makes the end a stop time (next_stop).
@@ -410,34 +229,6 @@ bool interpolate(IdaRun& r, double tt, int k, N_Vector v) {
   fail(r, "integration_failed",
        "interpolating the solution at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
   return false;
-}
-
-// IDAS's interpolants of s_i and s_i' at tt (nothing without sensitivities).
-bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) {
-  for (int i = 0; r.sens_on && i < r.ns; ++i) {
-    for (int k = 0; k < 2; ++k) {
-      const int flag = IDAGetSensDky1(r.mem, tt, k, i, k == 0 ? s[i] : sp[i]);
-      if (flag == IDA_SUCCESS) continue;
-      fail(r, "integration_failed",
-           "interpolating the sensitivities at t = " + std::to_string(tt) + " failed (" + ida_flag_name(flag) + ")", tt);
-      return false;
-    }
-  }
-  return true;
-}
-
-// The sensitivities at the last accepted step t_prev into r.s and r.sp: IDAS's interpolant
-// there, or, before any step since the last (re)initialization, the values it was given (they
-// are still in r.s, r.sp). False (the run not failed) if IDAS cannot give them.
-bool sensitivities_at_last_step(IdaRun& r) {
-  if (r.s_at_prev) return true;
-  long steps = 0;
-  if (IDAGetNumSteps(r.mem, &steps) != IDA_SUCCESS) return false;
-  for (int i = 0; steps > 0 && i < r.ns; ++i)
-    if (IDAGetSensDky1(r.mem, r.t_prev, 0, i, r.s[i]) != IDA_SUCCESS ||
-        IDAGetSensDky1(r.mem, r.t_prev, 1, i, r.sp[i]) != IDA_SUCCESS)
-      return false;
-  return true;
 }
 
 // IDA stopped with an error: the message names the worst error estimates and IDA's own words.
@@ -537,8 +328,6 @@ void finish_past_end(IdaRun& r, int flag, double tret) {
 // The state IDA returns at a root is interpolated, and the interpolated velocities are not
 // error-controlled at index 3. Step back to the last accepted step and integrate again with the
 // root time as stop time, so that the state at the root is a converged step. False: the run ends.
-bool drop_sensitivities(IdaRun& r, int flag);
-
 bool step_onto_root(IdaRun& r, double t_root) {
   const double h_default = r.ud.h_initial;
   choose_initial_step(r, r.t_prev);
@@ -625,40 +414,6 @@ bool restart(IdaRun& r, const int* roots) {
   return true;
 }
 
-// The sensitivities' robust residual from the last accepted step: their values there (IDAS's
-// interpolant), made consistent by the problem, and IDA anew. False if that cannot be done.
-bool retry_sensitivities(IdaRun& r) {
-  if (!sensitivities_at_last_step(r)) return false;
-  back_to_last_step(r);
-  try {
-    r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
-  } catch (const SolveError&) {
-    return false;
-  }
-  r.stats.sensitivity_fallback_time = r.t;
-  start_again(r);
-  return true;
-}
-
-// IDA failed with the sensitivities on: the run goes on without them from its last accepted
-// step (their rows end there; IdaStats::sensitivity_failure says why). Where the state itself
-// cannot go on, it fails again there and the run ends with that failure.
-bool drop_sensitivities(IdaRun& r, int flag) {
-  if (r.o->sensitivities->fall_back() && retry_sensitivities(r)) return true;
-  double tt = r.t;
-  IDAGetCurrentTime(r.mem, &tt);
-  std::ostringstream os;
-  os << "IDA failed with the sensitivities at t = " << tt << " (" << ida_flag_name(flag) << ")";
-  if (!r.ud.callback_error.empty()) os << ": " << r.ud.callback_error;
-  os << "; the run went on without them from t = " << r.t_prev;
-  r.stats.sensitivity_failure = os.str();
-  check(IDASensToggleOff(r.mem), "IDASensToggleOff");
-  r.sens_on = false;
-  back_to_last_step(r);
-  start_again(r);
-  return true;
-}
-
 // One IDA step and what follows it (samples, an event, a breakpoint). False: the run ends.
 bool advance(IdaRun& r) {
   const IdaOptions& o = *r.o;
@@ -730,7 +485,9 @@ bool over_budget(IdaRun& r) {
   return true;
 }
 
-}  // namespace
+}  // namespace ida_detail
+
+using namespace ida_detail;
 
 IdaStats integrate(DaeProblem& problem, const IdaOptions& o, std::vector<double>& y0, std::vector<double>& yp0,
                    const std::function<bool(double, const double*, const double*)>& output) {
