@@ -15,6 +15,7 @@
 
 #include "cases/mbdae.h"
 #include "core/errors.h"
+#include "cases/tests/test_scenes.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -238,27 +239,10 @@ TEST(Loads, BushingRotationUnderATorque) {
   EXPECT_NEAR(r.column("z").back(), -2.0 * 9.81 / 800, 1e-8);
 }
 
-// A slider (mass 2) on a prismatic joint along z, pushed by fz = -K z - C vz given as an
-// expression of a position and a velocity sensor: a damped oscillator, K = 50, C = 2
-// (omega = 5, zeta = 0.1), z0 = 0.2 from rest.
+// The damped slider of test_scenes.h (fz = -K z - C vz from its sensors, K = 50, C = 2,
+// omega = 5, zeta = 0.1, z0 = 0.2 from rest) against its closed form.
 TEST(Loads, SliderPushedByAnExpressionOfItsState) {
-  const Result r = run_text(R"(name: slider
-gravity: [0, 0, 0]
-bodies:
-  - {name: slider, mass: 2.0, inertia: {xx: 0.1, yy: 0.1, zz: 0.1}}
-joints:
-  - {name: rail, parent: ground, child: slider, anchor: [0, 0, 0], chain: [T3], coordinates: [s]}
-coordinates:
-  s: {initial: 0.2}
-forces:
-  - {name: push, type: point_force, body: slider, point: com, fz: "-K * z - C * vz", parameters: {K: 50, C: 2}}
-sensors:
-  - {name: z, type: position, body: slider, point: [0, 0, 0], component: z}
-  - {name: vz, type: velocity, body: slider, component: z}
-analysis:
-  - {type: assembly, hold: [s]}
-  - {type: dynamics, t_end: 4, output_step: 0.05, rtol: 1.0e-10, atol: 1.0e-12, formulation: index2-ggl}
-)");
+  const Result r = run_text(test_scenes::damped_slider("atol: 1.0e-12, formulation: index2-ggl"));
   const double omega = 5, zeta = 0.1, wd = omega * std::sqrt(1 - zeta * zeta);
   const auto& t = r.column("t");
   double worst = 0;

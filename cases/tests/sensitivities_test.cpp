@@ -14,6 +14,7 @@
 
 #include "cases/mbdae.h"
 #include "cases/tests/run_command.h"
+#include "cases/tests/test_scenes.h"
 #include "core/errors.h"
 #include "verification/iftomm/pendulum_exact.h"
 
@@ -23,26 +24,8 @@ namespace {
 using test_support::read_file;
 using test_support::run_command;
 
-// A slider (mass m) on a prismatic joint along z, pushed by fz = -K z - C vz, released at z0.
-std::string oscillator(const std::string& formulation) {
-  return R"(name: oscillator
-gravity: [0, 0, 0]
-bodies:
-  - {name: slider, mass: 2.0, inertia: {xx: 0.1, yy: 0.1, zz: 0.1}}
-joints:
-  - {name: rail, parent: ground, child: slider, anchor: [0, 0, 0], chain: [T3], coordinates: [s]}
-coordinates:
-  s: {initial: 0.2}
-forces:
-  - {name: push, type: point_force, body: slider, point: com, fz: "-K * z - C * vz", parameters: {K: 50, C: 2}}
-sensors:
-  - {name: z, type: position, body: slider, point: [0, 0, 0], component: z}
-  - {name: vz, type: velocity, body: slider, component: z}
-analysis:
-  - {type: assembly, hold: [s]}
-  - {type: dynamics, t_end: 4, output_step: 0.05, rtol: 1.0e-10, formulation: )" +
-         formulation + "}\n";
-}
+// The damped slider of test_scenes.h (mass m on a rail, pushed by fz = -K z - C vz, released at z0).
+std::string oscillator(const std::string& formulation) { return test_scenes::damped_slider("formulation: " + formulation); }
 
 // The oscillator's closed form: z(t) and vz(t) for stiffness K, damping C, mass m, start z0.
 struct Oscillator {
