@@ -59,7 +59,12 @@ void GglDae::error_weights(double h, const double* y, double rtol, double atol, 
   const double am = (atol + noise) / h;
   if (v_in_test_) {
     state_weights(h, y, rtol, atol, w);
-    error_per_unit_span(newton_step(h), y, w);
+    // The floor of v: GGL's v carries a position's rounding per step (eps |r| / h, through
+    // q' = v + Phi_q^T mu), noise that adds up over the S / h steps as a random walk, to
+    // eps |r| / h sqrt(S / h): a velocity tolerance below eps |r| / sqrt(h S) would ask the
+    // run's summed errors for less than that noise (docs/formulation.md, "Error control").
+    const double step = newton_step(h);
+    error_per_unit_span(step, std::sqrt(step * absolute_tolerances().span), y, w);
   } else {
     position_weights(y, rtol, aq, w);
     for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);

@@ -55,7 +55,7 @@ void Index1Dae::error_weights(double h, const double* y, double rtol, double ato
   const double noise = position_noise(y);
   const double al = mass_scale_ * (atol + noise) / h;
   state_weights(h, y, rtol, atol, w);
-  error_per_unit_span(newton_step(h), y, w);
+  error_per_unit_span(newton_step(h), newton_step(h), y, w);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 

@@ -141,7 +141,7 @@ void MultibodyDae::state_weights(double h, const double* y, double rtol, double 
   }
 }
 
-void MultibodyDae::error_per_unit_span(double h, const double* y, double* w) const {
+void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w) const {
   if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
   const double f = std::fmax(1.0, abs_tol_.span / h);
   double rmax = abs_tol_.length, vmax = abs_tol_.length / abs_tol_.time;
@@ -149,7 +149,8 @@ void MultibodyDae::error_per_unit_span(double h, const double* y, double* w) con
   for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
   const double e = kSpanRoundingFloor;
   const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
-  const double w_velocity = 1.0 / (e * std::fmax(vmax, rmax / h)), w_rate = 1.0 / (e * std::fmax(1.0, 1.0 / h));
+  const double w_velocity = 1.0 / (e * std::fmax(vmax, rmax / noise_step));
+  const double w_rate = 1.0 / (e * std::fmax(1.0, 1.0 / noise_step));
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {
     const bool euler = i % 7 >= 3;

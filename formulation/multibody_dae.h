@@ -152,9 +152,11 @@ class MultibodyDae : public DaeProblem {
   // Error per unit of the run's span (index2-ggl, index1, penalty; docs/formulation.md "Error
   // control"): the weights of q and v (the first 2 nq of w) tightened by S/h, S the span and h
   // the integrator's step, so that the local errors of the steps add up to about the tolerance
-  // over the run; never tighter than 100 roundings of the model's positions and velocities
-  // (positions max(L, |r|), velocities max(L/T, |v|, |r|/h)), never looser than before.
-  void error_per_unit_span(double h, const double* y, double* w) const;
+  // over the run; never looser than before, never tighter than 100 roundings of the model's
+  // positions (max(L, |r|)) and velocities (max(L/T, |v|, |r| / noise_step)): `noise_step` is the
+  // time over which a position's rounding counts as velocity noise (h, or sqrt(h S) where that
+  // noise adds up as a random walk: GglDae::error_weights).
+  void error_per_unit_span(double h, double noise_step, const double* y, double* w) const;
   static constexpr double kSpanRoundingFloor = 1e2 * 2.220446049250313e-16;
   // How often the error control asked for positions below their rounding: calls of the weights,
   // and those where the rounding floor replaced the control's tolerance for most position
