@@ -47,6 +47,17 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
     for (int i = 0; i < nc_; ++i) asm_.add(ra + i, cl + i, -scale_ * inverse_penalty_);
 }
 
+void Index1Dae::derivative_times(const double* y, const double* x, double* out) {
+  MultibodyDae::derivative_times(y, x, out);
+  constraint_jacobian_rows(sys_, y, rows_);
+  double* f3 = out + 2 * nq_;
+  for (size_t k = 0; k < sys_.constraints.size(); ++k) {
+    const Constraint& c = sys_.constraints[k];
+    const Vec14 xl = gather_local(x + nq_, c.bi, c.bj);
+    for (int r = 0; r < c.rows(); ++r) f3[offsets_[k] + r] = scale_ * rows_[3 * k + r].dot(xl);
+  }
+}
+
 void Index1Dae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < 2 * nq_ ? 1.0 : 0.0;
 }

@@ -53,6 +53,8 @@ class Index1Dae : public MultibodyDae {
 
 
   bool velocities_error_tested() const override { return true; }
+  // F_y' x with this formulation's rows, s Phi_q x_v (their v' term).
+  void derivative_times(const double* y, const double* x, double* out) override;
   const BaumgarteParameters& baumgarte() const { return bg_; }
   // 1/p of the penalty term (0 without penalty).
   double inverse_penalty() const { return inverse_penalty_; }
@@ -63,6 +65,7 @@ class Index1Dae : public MultibodyDae {
   BaumgarteParameters bg_;
   bool exact_gamma_q_;
   double inverse_penalty_ = 0.0;
+  std::vector<Row14> rows_;  // derivative_times' constraint Jacobian rows
 };
 
 }  // namespace mbdae

@@ -37,6 +37,12 @@ void MultibodyDae::consistent_initial_values(double t, std::vector<double>& y, s
   std::fill(y.begin() + 2 * nq_ + nc_, y.end(), 0.0);  // further unknowns (GGL's mu)
 }
 
+void MultibodyDae::derivative_times(const double* y, const double* x, double* out) {
+  std::copy(x, x + nq_, out);
+  mass_times(sys_, y, x + nq_, out + nq_);
+  std::fill(out + 2 * nq_, out + size(), 0.0);
+}
+
 void MultibodyDae::record_pattern() {
   work_.resize(size());
   std::vector<double> y(size(), 0.0), yp(size(), 0.0);

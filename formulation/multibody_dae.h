@@ -71,6 +71,10 @@ class MultibodyDae : public DaeProblem {
   // Consistent initial values from the q and v in y: q and v projected onto the constraints,
   // y' = [v, a, 0...], lambda after v, the unknowns beyond 2 nq + nc (GGL's mu) zero.
   void consistent_initial_values(double t, std::vector<double>& y, std::vector<double>& yp);
+  // out = F_y' x, the residual's derivative with respect to y' times x (size() values; every
+  // formulation's F is affine in y'): the shared rows' x_q (F1) and M(q) x_v (F2), zero for the
+  // formulation's own rows unless it overrides this (Index1Dae: its rows hold Phi_q v').
+  virtual void derivative_times(const double* y, const double* x, double* out);
   // Output state from an interpolated (y, y'): optionally projected onto the constraint
   // manifold (positions and velocities), then the accelerations solved from it. Returns the
   // position violation of the interpolated y. (Same contract as Index3Dae::consistent_output.)

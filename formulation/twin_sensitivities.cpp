@@ -13,7 +13,6 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
   a0_.resize(base_->jacobian_pattern().nnz());
-  r0_.resize(n);
   for (const ParameterTwins& p : twins_)
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
       throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
@@ -42,7 +41,6 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
                                 const double* const* sp, double* const* r) {
   follow(*base_);
   if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
-  if (const int flag = base_->residual(t, y, yp, r0_.data()); flag != 0) return flag;
   for (size_t i = 0; i < twins_.size(); ++i) {
     int flag = add_state_terms(t, y, yp, twins_[i], s[i], sp[i], r[i]);
     if (flag == 0) flag = add_parameter_term(t, y, yp, twins_[i], r[i]);
@@ -51,14 +49,12 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
   return 0;
 }
 
-// r = F_y s + F_y' s': F_y' s' by a difference in y' (F is affine in y'), F_y s by a central
+// r = F_y s + F_y' s': F_y' s' exactly (the formulation's derivative_times), F_y s by a central
 // difference along s or, after fall_back(), by A0.
 int TwinSensitivities::add_state_terms(double t, const double* y, const double* yp, const ParameterTwins& p,
                                        const double* s, const double* sp, double* r) {
   const int n = run_.size();
-  for (int k = 0; k < n; ++k) ypt_[k] = yp[k] + p.scale * sp[k];
-  if (const int flag = base_->residual(t, y, ypt_.data(), r); flag != 0) return flag;
-  for (int k = 0; k < n; ++k) r[k] = (r[k] - r0_[k]) / p.scale;
+  base_->derivative_times(y, sp, r);
   if (exact_) {
     const CscPattern& pat = base_->jacobian_pattern();
     for (int c = 0; c < n; ++c)

@@ -4,10 +4,10 @@
 // same coordinates and equations), whose modes and turns follow the run's. The sensitivity
 // equations' residual is
 //
-//   F_y s + F_y' s' + F_p  =  F_y s  +  [F(y, y' + b s') - F(y, y')] / b  +  [F+(y, y') - F-(y, y')] / (2 d),
+//   F_y s + F_y' s' + F_p  =  F_y s  +  F_y' s'  +  [F+(y, y') - F-(y, y')] / (2 d),
 //
-// F_y' s' exact to rounding by a difference in y' alone, every formulation's F being affine in
-// y' (b the parameter's scale, so that b s' is a change of y' in its own units); F_p a central
+// F_y' s' exact, from the formulation (MultibodyDae::derivative_times: every formulation's F is
+// affine in y', F_y' holds the identity, the mass matrix and index1's Phi_q); F_p a central
 // difference over the twins at the same (y, y'): the terms that do not depend on p are evaluated
 // bit for bit alike in both twins and cancel, so its rounding is that of the terms p enters, and
 // no parameter needs code of its own (force parameters, masses, hardpoints, gravity, expression
@@ -78,7 +78,7 @@ class TwinSensitivities : public SensitivityProblem {
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
   bool exact_ = false;  // A0 = F_y assembled (after fall_back), else F_y s by differences
-  std::vector<double> yt_, ypt_, rp_, rm_, r0_;  // work (size of the DAE)
+  std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
   std::string failure_;
 };

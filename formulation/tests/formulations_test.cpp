@@ -80,6 +80,40 @@ TEST(Formulations, GglNewtonMatrixIsExact) {
   EXPECT_GT(fd.block(2 * nq + nc, 0, nc, nq).cwiseAbs().maxCoeff(), 1e-3);
 }
 
+// F_y' x (MultibodyDae::derivative_times, the sensitivities' F_y' s') against the residual's own
+// central difference in y', exact for a residual affine in y': every formulation, every row.
+TEST(Formulations, DerivativeTimesIsTheResidualsDerivativeInYp) {
+  const System sys = build_system(testing::all_types_model());
+  Index3Dae i3(sys, 3.0, true);
+  GglDae ggl(sys, 7.0);
+  Index1Dae i1(sys, 5.0, BaumgarteParameters{10.0, 20.0});
+  Index1Dae pen(sys, 5.0, BaumgarteParameters{10.0, 20.0}, false, 1e7);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (MultibodyDae* dae : std::vector<MultibodyDae*>{&i3, &ggl, &i1, &pen}) {
+    const int n = dae->size();
+    std::vector<double> y, yp, x(n), ypp(n), ypm(n), rp(n), rm(n), out(n);
+    testing::dae_vectors(random_state(sys, 5), n, dae == &ggl, y, yp);
+    for (double& v : x) v = u(rng);
+    for (int i = 0; i < n; ++i) {
+      ypp[i] = yp[i] + x[i];
+      ypm[i] = yp[i] - x[i];
+    }
+    ASSERT_EQ(dae->residual(0.3, y.data(), ypp.data(), rp.data()), 0);
+    ASSERT_EQ(dae->residual(0.3, y.data(), ypm.data(), rm.data()), 0);
+    dae->derivative_times(y.data(), x.data(), out.data());
+    double worst = 0, largest = 0;
+    for (int i = 0; i < n; ++i) {
+      const double fd = 0.5 * (rp[i] - rm[i]);
+      worst = std::max(worst, std::fabs(out[i] - fd) / (1 + std::fabs(fd)));
+      largest = std::max(largest, std::fabs(fd));
+    }
+    std::printf("  F_y' x of a %d-unknown DAE: largest %.3g, worst relative difference %.2e\n", n, largest, worst);
+    EXPECT_LT(worst, 1e-12);
+    EXPECT_GT(largest, 0.1);  // not trivially zero
+  }
+}
+
 TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
   const System sys = build_system(testing::all_types_model());
   const double scale = 7.0;
