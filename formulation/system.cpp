@@ -101,8 +101,12 @@ CoordinateTurns initial_turns(const System& sys) {
 void update_turns(const System& sys, const double* q, const double* v, double t, CoordinateTurns& turns) {
   for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
     if (!counts_turns(sys, k)) continue;
-    const double value = continuous_coordinate(sys, k, coordinate_value(sys, k, q), t, &turns);
-    const double rate = coordinate_rate(sys, k, q, v);
+    // One jet for the value and the rate (coordinate_value and coordinate_rate would evaluate it
+    // twice: a sixth of a plain index2-ggl step on Dynamics I, docs/performance.md).
+    const CoordinateFunction& f = sys.coordinates[k].function;
+    const ScalarJet jet = coordinate_jet(f, gather(q, f.body_parent, f.body_child));
+    const double value = continuous_coordinate(sys, k, jet.value, t, &turns);
+    const double rate = jet.grad.dot(gather_local(v, f.body_parent, f.body_child));
     if (!std::isfinite(value) || !std::isfinite(rate)) continue;  // the run stops on it elsewhere
     turns.value[k] = value;
     turns.rate[k] = rate;
