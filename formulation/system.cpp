@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "formulation/force_types.h"
 #include "formulation/model_rules.h"
 #include "formulation/system_build.h"
 
@@ -98,9 +99,23 @@ CoordinateTurns initial_turns(const System& sys) {
   return turns;
 }
 
+std::vector<int> coordinates_with_turns(const System& sys) {
+  std::vector<char> read(sys.coordinates.size(), 0);
+  for (const Force& f : sys.forces)
+    if (force_type(f.type).attach == ForceAttach::kCoordinate && !f.wrap && f.coordinate_index >= 0)
+      read[f.coordinate_index] = 1;
+  for (const Sensor& s : sys.sensors)
+    if (s.type == SensorSpec::Type::kCoordinate && s.unwrap && s.target >= 0) read[s.target] = 1;
+  std::vector<int> out;
+  for (int k = 0; k < static_cast<int>(read.size()); ++k)
+    if (read[k] && counts_turns(sys, k)) out.push_back(k);
+  return out;
+}
+
+// Only the coordinates whose turns are read: a coordinate's jet costs thousands of instructions,
+// and a mechanism has one per joint angle (docs/performance.md).
 void update_turns(const System& sys, const double* q, const double* v, double t, CoordinateTurns& turns) {
-  for (int k = 0; k < static_cast<int>(sys.coordinates.size()); ++k) {
-    if (!counts_turns(sys, k)) continue;
+  for (const int k : sys.turn_coordinates) {
     // One jet for the value and the rate (coordinate_value and coordinate_rate would evaluate it
     // twice: a sixth of a plain index2-ggl step on Dynamics I, docs/performance.md).
     const CoordinateFunction& f = sys.coordinates[k].function;
@@ -130,6 +145,7 @@ System build_system(const Model& model) {
   add_joint_constraints(index, sys);
   add_cut_constraints(index, sys);
   add_forces_and_sensors(index, sys);
+  sys.turn_coordinates = coordinates_with_turns(sys);
   return sys;
 }
 

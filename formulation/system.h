@@ -111,6 +111,9 @@ struct System {
   std::vector<Force> forces;
   std::vector<Sensor> sensors;
   std::vector<double> q0;  // initial guess from the joint coordinates' initial values
+  // The coordinates whose turns a run tracks (update_turns): those counting turns that a joint
+  // force (not wrapped) or an unwrapped coordinate sensor reads. Set by build_system.
+  std::vector<int> turn_coordinates;
 
   int num_bodies() const { return static_cast<int>(bodies.size()); }
   int nq() const { return 7 * num_bodies(); }
@@ -148,6 +151,8 @@ struct CoordinateTurns {
 // Whether coordinate k is a rotation whose turns are counted (atan2 angles: the first and last of a
 // chain's rotations; the middle one, an asin, stays within [-pi/2, pi/2]).
 bool counts_turns(const System& sys, int k);
+// System::turn_coordinates of sys as it stands (its forces and sensors).
+std::vector<int> coordinates_with_turns(const System& sys);
 // The continuous value of coordinate k from its measured value `raw` at time t.
 double continuous_coordinate(const System& sys, int k, double raw, double t, const CoordinateTurns* turns);
 // Turns at the start (value: the coordinates' initial values, no rate).

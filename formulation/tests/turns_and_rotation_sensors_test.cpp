@@ -54,6 +54,16 @@ std::vector<double> sensors_at_q0(const System& sys) {
   return out;
 }
 
+// A run tracks the turns of the coordinates that something reads with its turns: the spring
+// (not wrapped) or an unwrapped coordinate sensor; a wrapped spring and a wrapped sensor do not.
+TEST(Turns, TrackedOnlyWhereRead) {
+  EXPECT_EQ(build_system(torsion_pendulum(0.5, 1.0, 1.0)).turn_coordinates, std::vector<int>{0});
+  Model wrapped = torsion_pendulum(0.5, 1.0, 1.0, true);
+  EXPECT_EQ(build_system(wrapped).turn_coordinates, std::vector<int>{0});  // the sensor unwraps
+  wrapped.sensors.back().wrap = true;
+  EXPECT_TRUE(build_system(wrapped).turn_coordinates.empty());
+}
+
 // Wound 10 rad with unit stiffness the spring gives -10 N m (wrapped, it saw 10 - 4 pi: +2.57).
 TEST(Turns, SpringWoundTenRadians) {
   const System sys = build_system(torsion_pendulum(0.5, 1.0, 10.0));
