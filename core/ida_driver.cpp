@@ -12,6 +12,7 @@
 
 #include "core/errors.h"
 #include "core/finite_check.h"
+#include "core/fused_vector.h"
 #include "core/ida_run.h"
 #include "core/reduced_linear_solver.h"
 #include "core/sundials_compat.h"
@@ -178,7 +179,10 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.n = r.problem->size();
   r.ctx = make_sun_context();
   if (!r.ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
-  for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) *v = check(N_VNew_Serial(r.n, r.ctx), "N_VNew_Serial");
+  for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) {
+    *v = check(N_VNew_Serial(r.n, r.ctx), "N_VNew_Serial");
+    use_fused_operations(*v);  // IDA's vectors are clones of y: they inherit it
+  }
   std::memcpy(data(r.y), y0.data(), r.n * sizeof(double));
   std::memcpy(data(r.yp), yp0.data(), r.n * sizeof(double));
   r.problem->error_test_mask(data(r.id));
