@@ -14,31 +14,27 @@ KinematicSensitivities::KinematicSensitivities(const System& run,
                                                std::vector<double> deltas)
     : run_(run), twins_(std::move(twins)), deltas_(std::move(deltas)), offsets_(constraint_offsets(run)) {
   const int n = run_.nq();
-  phi_q_.resize(n, n);
+  // Phi_q's pattern (assemble_constraint_jacobian's calls, the same at every q), copied once
+  // into phi_q_ with zero values; each sample assembles its values in place.
+  asm_.begin_pattern(n, n);
+  assemble_constraint_jacobian(run_, offsets_, run_.q0.data(), 1.0, 0, 0, -1, -1, asm_);
+  asm_.finalize();
+  const CscPattern& p = asm_.pattern();
+  std::vector<double> zeros(p.nnz(), 0.0);
+  phi_q_ = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, p.nnz(), p.colptr.data(), p.rowind.data(),
+                                                         zeros.data());
+  lu_.analyzePattern(phi_q_);
   rhs_.resize(n);
   for (auto* v : {&a_, &b_, &qt_, &vt_}) v->resize(n);
   yp_.resize(run_.sensors.size());
   ym_.resize(run_.sensors.size());
 }
 
-// Phi_q at q from the constraints' local rows (the pattern is the same at every q: analysed once).
+// Phi_q at q into phi_q_'s values (its pattern analysed once).
 bool KinematicSensitivities::factorize(const double* q) {
-  std::vector<Eigen::Triplet<double>> entries;
-  Row14 rows[3];
-  for (size_t k = 0; k < run_.constraints.size(); ++k) {
-    const Constraint& c = run_.constraints[k];
-    constraint_jacobian(c, gather(q, c.bi, c.bj), rows);
-    for (int r = 0; r < c.rows(); ++r)
-      for (int l = 0; l < 14; ++l) {
-        const int col = global_index(c.bi, c.bj, l);
-        if (col >= 0) entries.emplace_back(offsets_[k] + r, col, rows[r](l));  // zeros kept: a fixed pattern
-      }
-  }
-  phi_q_.setFromTriplets(entries.begin(), entries.end());
-  if (!analysed_) {
-    lu_.analyzePattern(phi_q_);
-    analysed_ = true;
-  }
+  asm_.begin_values(phi_q_.valuePtr());
+  assemble_constraint_jacobian(run_, offsets_, q, 1.0, 0, 0, -1, -1, asm_);
+  asm_.end_values();
   lu_.factorize(phi_q_);
   if (lu_.info() == Eigen::Success) return true;
   failure_ = "the constraint Jacobian is singular at this kinematic sample (a dead centre?)";

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/sparse_assembler.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -40,9 +41,9 @@ class KinematicSensitivities {
   std::vector<std::pair<const System*, const System*>> twins_;
   std::vector<double> deltas_;
   std::vector<int> offsets_;
+  SparseAssembler asm_;  // Phi_q's pattern, recorded once; its values assembled into phi_q_
   Eigen::SparseMatrix<double> phi_q_;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
-  bool analysed_ = false;
   Eigen::VectorXd rhs_, sq_, sv_;
   std::vector<double> a_, b_, qt_, vt_, yp_, ym_;
   std::string failure_;
