@@ -24,6 +24,7 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   work2_.resize(n);
   scratch_.resize(3 * static_cast<size_t>(n));
   for (auto& h : history_) h.resize(n);
+  rows_.resize(3 * sys.constraints.size());
 }
 
 void AugmentedSolver::assemble(const double* q, bool with_mass, double regularization) {
@@ -58,6 +59,12 @@ void AugmentedSolver::assemble_acceleration_system(const std::vector<char>& mode
   assemble_values(q, true);
   check_overflow(values_.data(), static_cast<int>(values_.size()), t, "the mass matrix entries",
                  "a mass or an inertia");
+  acceleration_right_side(modes, q, v, t);
+}
+
+// b = [Q; gamma] into rhs_.
+void AugmentedSolver::acceleration_right_side(const std::vector<char>& modes, const double* q,
+                                              const double* v, double t) {
   generalized_forces(sys_, modes, q, v, t, rhs_.data(), turns);
   check_overflow(rhs_.data(), nq_, t, "the applied forces", "a mass, gravity or a force");
   constraint_rates(sys_, offsets_, q, v, t, nullptr, rhs_.data() + nq_);
@@ -84,8 +91,8 @@ bool AugmentedSolver::output_accelerations(const std::vector<char>& modes, const
   if (history_size_ > 0 && !(t > history_t_[0])) history_size_ = 0;
   bool refined = false;
   if (klu_output_.factored() && history_size_ > 0) {
-    assemble_acceleration_system(modes, q, v, t);
-    refined = refine_accelerations(t, tolerance);  // the solution into rhs_
+    acceleration_right_side(modes, q, v, t);
+    refined = refine_accelerations(q, t, tolerance);  // the solution into rhs_
   }
   if (!refined && !solve_accelerations(klu_output_, modes, q, v, t)) return false;
   ++(refined ? refinement.refined : refinement.direct);
@@ -174,21 +181,28 @@ void AugmentedSolver::choose_extrapolation_order(double t) {
   }
 }
 
-// From the extrapolated x: r = b - K x (K in values_, b in rhs_), dx = K0^-1 r, x += dx. The
+// r = b - K x without assembling K: M a + Phi_q^T lambda and Phi_q a, from the constraint rows in
+// rows_ (evaluated once per sample).
+void AugmentedSolver::acceleration_residual(const double* q, const double* x, double* r) const {
+  mass_times(sys_, q, x, r);
+  add_constraint_forces(sys_, offsets_, rows_, x + nq_, r);
+  constraint_rows_times(sys_, offsets_, rows_, x, r + nq_);
+  for (int i = 0; i < nq_ + nc_; ++i) r[i] = rhs_[i] - r[i];
+}
+
+// From the extrapolated x: r = b - K x (b in rhs_), dx = K0^-1 r, x += dx. The
 // iteration contracts by rho = |K0^-1 (K - K0)| per correction (small for nearby states); the
 // error left after a correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio
 // of successive corrections (per block, a and lambda). Accepted when that estimate is below
 // `tolerance` of the block's max norm; a slow (rho > 0.5) or diverging iteration is not.
-bool AugmentedSolver::refine_accelerations(double t, double tolerance) {
-  const CscPattern& p = asm_.pattern();
+bool AugmentedSolver::refine_accelerations(const double* q, double t, double tolerance) {
   const int n = nq_ + nc_;
   double* x = work2_.data();
   predict_accelerations(t, std::min(points_, history_size_), x);
+  constraint_jacobian_rows(sys_, q, rows_);
   double last_dx[2] = {0, 0};
   for (int it = 0; it < kMaxRefinements; ++it) {
-    std::copy(rhs_.begin(), rhs_.end(), work_.begin());
-    for (int j = 0; j < n; ++j)
-      for (int k = p.colptr[j]; k < p.colptr[j + 1]; ++k) work_[p.rowind[k]] -= values_[k] * x[j];
+    acceleration_residual(q, x, work_.data());
     if (!klu_output_.solve(work_.data())) return false;
     ++refinement.corrections;
     double dx[2] = {0, 0}, xmax[2] = {0, 0};

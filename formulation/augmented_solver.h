@@ -11,6 +11,7 @@
 
 #include "core/klu_solver.h"
 #include "core/sparse_assembler.h"
+#include "formulation/body_point.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -31,7 +32,8 @@ class AugmentedSolver {
                      double* a, double* lambda);
   // The accelerations of an output sample, without a factorization where one of a nearby state
   // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration
-  // matrix K0 (a KluSolver of its own, so that output samples do not change the factorizations
+  // matrix K0 (K x matrix-free: M a, Phi_q^T lambda and Phi_q a from the constraint rows; K is
+  // not assembled) (a KluSolver of its own, so that output samples do not change the factorizations
   // the integration's own solves see), from x extrapolated through the last output samples (a
   // polynomial in t, its degree chosen from the samples: choose_extrapolation_order), accepted
   // when the estimated error of a and of lambda is below `tolerance` times their max norms; else the direct solve of accelerations(). Samples come in increasing
@@ -67,7 +69,9 @@ class AugmentedSolver {
   void extrapolation_weights(double t, int points, double* w) const;
   void predict_accelerations(double t, int points, double* x) const;
   void choose_extrapolation_order(double t);
-  bool refine_accelerations(double t, double tolerance);
+  void acceleration_right_side(const std::vector<char>& modes, const double* q, const double* v, double t);
+  void acceleration_residual(const double* q, const double* x, double* r) const;
+  bool refine_accelerations(const double* q, double t, double tolerance);
   void remember_output(double t);
   void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
   const System& sys_;
@@ -76,6 +80,7 @@ class AugmentedSolver {
   SparseAssembler asm_;
   KluSolver klu_;
   std::vector<double> values_, rhs_, work_, work2_, trial_;
+  std::vector<Row14> rows_;  // the constraint Jacobian's rows at an output sample's q
   KluSolver klu_output_;  // output samples' acceleration matrix K0
   bool output_prepared_ = false;
   // The last output solutions [a; lambda] and their times (history_[0] the newest), and how many

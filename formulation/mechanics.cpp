@@ -136,6 +136,15 @@ void add_constraint_forces(const System& sys, const std::vector<int>& off, const
     add_rows_transposed(sys.constraints[k], rows.data() + 3 * k, lambda + off[k], out);
 }
 
+void constraint_rows_times(const System& sys, const std::vector<int>& off, const std::vector<Row14>& rows,
+                           const double* v, double* out) {
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[3 * k + r].dot(vl);
+  }
+}
+
 void constraint_jacobian_times(const System& sys, const std::vector<int>& off, const double* q,
                                const double* v, double* out) {
   Row14 rows[3];

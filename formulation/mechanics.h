@@ -46,6 +46,9 @@ void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Ro
 // out += Phi_q^T lambda, Phi_q from constraint_jacobian_rows().
 void add_constraint_forces(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
                            const double* lambda, double* out);
+// out = Phi_q v, Phi_q from constraint_jacobian_rows().
+void constraint_rows_times(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
+                           const double* v, double* out);
 // out = Phi_q v.
 void constraint_jacobian_times(const System& sys, const std::vector<int>& offsets,
                                const double* q, const double* v, double* out);
