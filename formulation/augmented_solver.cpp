@@ -25,6 +25,7 @@ AugmentedSolver::AugmentedSolver(const System& sys)
   scratch_.resize(3 * static_cast<size_t>(n));
   for (auto& h : history_) h.resize(n);
   rows_.resize(3 * sys.constraints.size());
+  phi_ = constraint_rows_pattern(sys);
 }
 
 void AugmentedSolver::assemble(const double* q, bool with_mass, double regularization) {
@@ -185,8 +186,7 @@ void AugmentedSolver::choose_extrapolation_order(double t) {
 // rows_ (evaluated once per sample).
 void AugmentedSolver::acceleration_residual(const double* q, const double* x, double* r) const {
   mass_times(sys_, q, x, r);
-  add_constraint_forces(sys_, offsets_, rows_, x + nq_, r);
-  constraint_rows_times(sys_, offsets_, rows_, x, r + nq_);
+  constraint_rows_products(phi_, rows_, x, x + nq_, r, r + nq_);
   for (int i = 0; i < nq_ + nc_; ++i) r[i] = rhs_[i] - r[i];
 }
 
@@ -209,8 +209,10 @@ bool AugmentedSolver::refine_accelerations(const double* q, double t, double tol
     for (int i = 0; i < n; ++i) {
       x[i] += work_[i];
       const int b = i >= nq_;
-      dx[b] = std::fmax(dx[b], std::fabs(work_[i]));
-      xmax[b] = std::fmax(xmax[b], std::fabs(x[i]));
+      // std::max is inlined (std::fmax is a libm call); as with fmax a NaN is skipped here and
+      // caught by check_overflow.
+      dx[b] = std::max(dx[b], std::fabs(work_[i]));
+      xmax[b] = std::max(xmax[b], std::fabs(x[i]));
     }
     if (!std::isfinite(dx[0] + dx[1] + xmax[0] + xmax[1])) return false;
     bool converged = true, hopeless = false;

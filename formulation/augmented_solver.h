@@ -12,6 +12,7 @@
 #include "core/klu_solver.h"
 #include "core/sparse_assembler.h"
 #include "formulation/body_point.h"
+#include "formulation/mechanics.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -80,7 +81,8 @@ class AugmentedSolver {
   SparseAssembler asm_;
   KluSolver klu_;
   std::vector<double> values_, rhs_, work_, work2_, trial_;
-  std::vector<Row14> rows_;  // the constraint Jacobian's rows at an output sample's q
+  std::vector<Row14> rows_;    // the constraint Jacobian's rows at an output sample's q
+  ConstraintRowsPattern phi_;  // their structural entries (the products with Phi_q)
   KluSolver klu_output_;  // output samples' acceleration matrix K0
   bool output_prepared_ = false;
   // The last output solutions [a; lambda] and their times (history_[0] the newest), and how many

@@ -136,15 +136,6 @@ void add_constraint_forces(const System& sys, const std::vector<int>& off, const
     add_rows_transposed(sys.constraints[k], rows.data() + 3 * k, lambda + off[k], out);
 }
 
-void constraint_rows_times(const System& sys, const std::vector<int>& off, const std::vector<Row14>& rows,
-                           const double* v, double* out) {
-  for (size_t k = 0; k < sys.constraints.size(); ++k) {
-    const Constraint& c = sys.constraints[k];
-    const Vec14 vl = gather_local(v, c.bi, c.bj);
-    for (int r = 0; r < c.rows(); ++r) out[off[k] + r] = rows[3 * k + r].dot(vl);
-  }
-}
-
 void constraint_jacobian_times(const System& sys, const std::vector<int>& off, const double* q,
                                const double* v, double* out) {
   Row14 rows[3];
@@ -284,6 +275,40 @@ void assemble_constraint_jacobian(const System& sys, const std::vector<int>& off
         if (row0t >= 0) a.add(row0t + g, col0t + row, rows[r](l));
       }
     }
+  }
+}
+
+ConstraintRowsPattern constraint_rows_pattern(const System& sys) {
+  ConstraintRowsPattern p;
+  p.rowptr.push_back(0);
+  for (size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    for (int r = 0; r < c.rows(); ++r) {
+      for (unsigned m = structural_columns(c, r); m; m &= m - 1) {
+        const int l = __builtin_ctz(m), g = global_index(c.bi, c.bj, l);
+        if (g < 0) continue;
+        p.col.push_back(g);
+        p.local.push_back(static_cast<unsigned char>(l));
+      }
+      p.source.push_back(static_cast<int>(3 * k) + r);
+      p.rowptr.push_back(static_cast<int>(p.col.size()));
+    }
+  }
+  return p;
+}
+
+void constraint_rows_products(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* a,
+                              const double* lambda, double* out_q, double* out_c) {
+  const int n = static_cast<int>(p.source.size());
+  for (int i = 0; i < n; ++i) {
+    const double* row = rows[p.source[i]].data();
+    double s = 0;
+    for (int e = p.rowptr[i]; e < p.rowptr[i + 1]; ++e) {
+      const double v = row[p.local[e]];
+      out_q[p.col[e]] += v * lambda[i];
+      s += v * a[p.col[e]];
+    }
+    out_c[i] = s;
   }
 }
 

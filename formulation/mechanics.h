@@ -46,9 +46,17 @@ void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Ro
 // out += Phi_q^T lambda, Phi_q from constraint_jacobian_rows().
 void add_constraint_forces(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
                            const double* lambda, double* out);
-// out = Phi_q v, Phi_q from constraint_jacobian_rows().
-void constraint_rows_times(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
-                           const double* v, double* out);
+// Phi_q's structural entries row by row (those assemble_constraint_jacobian adds), for products
+// with the rows of constraint_jacobian_rows() without assembling Phi_q: stacked row i's entries
+// are e in [rowptr[i], rowptr[i + 1]), the value rows[source[i]](local[e]) at global column col[e].
+struct ConstraintRowsPattern {
+  std::vector<int> rowptr, source, col;
+  std::vector<unsigned char> local;
+};
+ConstraintRowsPattern constraint_rows_pattern(const System& sys);
+// out_q += Phi_q^T lambda and out_c = Phi_q a, in one pass over the rows.
+void constraint_rows_products(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* a,
+                              const double* lambda, double* out_q, double* out_c);
 // out = Phi_q v.
 void constraint_jacobian_times(const System& sys, const std::vector<int>& offsets,
                                const double* q, const double* v, double* out);
