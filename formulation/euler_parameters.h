@@ -51,14 +51,25 @@ inline Mat34 L_matrix(const Vec4& p) {
   return l;
 }
 
-// B(p, s) = d(A(p) s)/dp.
+// B(p, s) = d(A(p) s)/dp = 2 [ e0 s + e x s,  (e.s) I + e s^T - s e^T - e0 [s]x ], entry by
+// entry (a hot kernel: every point constraint and force), with Eigen's operations and order.
 inline Mat34 B_matrix(const Vec4& p, const Vec3& s) {
-  const double e0 = p[0];
-  const Vec3 e = p.tail<3>();
+  const double e0 = p[0], e1 = p[1], e2 = p[2], e3 = p[3];
+  const double es = p.tail<3>().dot(s);
   Mat34 b;
-  b.col(0) = 2.0 * (e0 * s + e.cross(s));
-  b.rightCols<3>() =
-      2.0 * (e.dot(s) * Mat3::Identity() + e * s.transpose() - s * e.transpose() - e0 * skew(s));
+  b(0, 0) = 2.0 * (e0 * s[0] + (e2 * s[2] - e3 * s[1]));
+  b(1, 0) = 2.0 * (e0 * s[1] + (e3 * s[0] - e1 * s[2]));
+  b(2, 0) = 2.0 * (e0 * s[2] + (e1 * s[1] - e2 * s[0]));
+  // (e.s) I + e s^T - s e^T - e0 [s]x, [s]x = [0 -s2 s1; s2 0 -s0; -s1 s0 0].
+  b(0, 1) = 2.0 * ((es + e1 * s[0]) - s[0] * e1);
+  b(1, 2) = 2.0 * ((es + e2 * s[1]) - s[1] * e2);
+  b(2, 3) = 2.0 * ((es + e3 * s[2]) - s[2] * e3);
+  b(0, 2) = 2.0 * ((e1 * s[1] - s[0] * e2) - e0 * -s[2]);
+  b(0, 3) = 2.0 * ((e1 * s[2] - s[0] * e3) - e0 * s[1]);
+  b(1, 1) = 2.0 * ((e2 * s[0] - s[1] * e1) - e0 * s[2]);
+  b(1, 3) = 2.0 * ((e2 * s[2] - s[1] * e3) - e0 * -s[0]);
+  b(2, 1) = 2.0 * ((e3 * s[0] - s[2] * e1) - e0 * -s[1]);
+  b(2, 2) = 2.0 * ((e3 * s[1] - s[2] * e2) - e0 * s[0]);
   return b;
 }
 
