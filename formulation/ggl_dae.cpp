@@ -19,7 +19,7 @@ int GglDae::residual(double t_in, const double* y, const double* yp, double* r) 
   const double* mu = y + 2 * nq_ + nc_;
   // F1 = q' - v + Phi_q^T mu,  F2 = M v' + Phi_q^T lambda - Q
   kinematic_and_momentum_residual(t, y, yp, r, work_.data());
-  add_constraint_forces(sys_, offsets_, constraint_rows(), mu, r);
+  add_constraint_forces(rows_pattern_, constraint_rows(), mu, r);
   // F3 = s Phi,  F4 = s (Phi_q v + Phi_t)
   double* f3 = r + 2 * nq_;
   double* f4 = f3 + nc_;

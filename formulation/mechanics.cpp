@@ -297,6 +297,16 @@ ConstraintRowsPattern constraint_rows_pattern(const System& sys) {
   return p;
 }
 
+void add_constraint_forces(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* lambda,
+                           double* out) {
+  const int n = static_cast<int>(p.source.size());
+  for (int i = 0; i < n; ++i) {
+    const double* row = rows[p.source[i]].data();
+    const double lam = lambda[i];
+    for (int e = p.rowptr[i]; e < p.rowptr[i + 1]; ++e) out[p.col[e]] += row[p.local[e]] * lam;
+  }
+}
+
 void constraint_rows_products(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* a,
                               const double* lambda, double* out_q, double* out_c) {
   const int n = static_cast<int>(p.source.size());

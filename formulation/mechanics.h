@@ -54,6 +54,10 @@ struct ConstraintRowsPattern {
   std::vector<unsigned char> local;
 };
 ConstraintRowsPattern constraint_rows_pattern(const System& sys);
+// out += Phi_q^T lambda over the structural entries only: the same sums, in the same order, as
+// add_constraint_forces with rows (the entries left out are zeros).
+void add_constraint_forces(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* lambda,
+                           double* out);
 // out_q += Phi_q^T lambda and out_c = Phi_q a, in one pass over the rows.
 void constraint_rows_products(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* a,
                               const double* lambda, double* out_q, double* out_c);

@@ -10,7 +10,8 @@
 namespace mbdae {
 
 MultibodyDae::MultibodyDae(const System& sys)
-    : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()), aug_(sys) {
+    : sys_(sys), offsets_(constraint_offsets(sys)), nq_(sys.nq()), nc_(offsets_.back()),
+      rows_pattern_(constraint_rows_pattern(sys)), aug_(sys) {
   state_.modes = initial_modes(sys, sys.q0.data(), 0.0);
   state_.turns = initial_turns(sys);
   aug_.turns = &state_.turns;
@@ -71,7 +72,7 @@ void MultibodyDae::kinematic_and_momentum_residual(double t, const double* y, co
   generalized_forces(sys_, state_.modes, q, v, t, force_work, &state_.turns);
   for (int i = 0; i < nq_; ++i) f2[i] -= force_work[i];
   constraint_jacobian_rows(sys_, q, state_.cache.constraint_rows);
-  add_constraint_forces(sys_, offsets_, state_.cache.constraint_rows, lambda, f2);
+  add_constraint_forces(rows_pattern_, state_.cache.constraint_rows, lambda, f2);
 }
 
 void MultibodyDae::assemble_kinematic_and_momentum(double t, double cj, const double* y,

@@ -189,6 +189,7 @@ class MultibodyDae : public DaeProblem {
   const System& sys_;
   std::vector<int> offsets_;
   int nq_, nc_;
+  ConstraintRowsPattern rows_pattern_;  // Phi_q's structural entries (the residuals' Phi_q^T lambda)
   double mass_scale_ = 1e-3;  // largest body mass (multipliers are forces: mass-scaled weights)
   double segment_end_ = 1e300;
   std::vector<int> switch_forces_;
