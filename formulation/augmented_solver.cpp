@@ -194,12 +194,20 @@ void AugmentedSolver::acceleration_residual(const double* q, const double* x, do
 // iteration contracts by rho = |K0^-1 (K - K0)| per correction (small for nearby states); the
 // error left after a correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio
 // of successive corrections (per block, a and lambda). Accepted when that estimate is below
-// `tolerance` of the block's max norm; a slow (rho > 0.5) or diverging iteration is not.
+// `tolerance` of the block's max norm (for a, at least of the applied forces' |Q| / m); a slow
+// (rho > 0.5) or diverging iteration is not.
 bool AugmentedSolver::refine_accelerations(const double* q, double t, double tolerance) {
   const int n = nq_ + nc_;
   double* x = work2_.data();
   predict_accelerations(t, std::min(points_, history_size_), x);
   constraint_jacobian_rows(sys_, q, rows_);
+  // The accelerations' scale is at least that of the applied forces (|Q| / m, gravity for a body
+  // that it pulls): a mechanism at rest has a = 0 up to rounding, and a tolerance relative to
+  // that alone could never be met (every sample would fall back to the direct solve).
+  double scale[2] = {0, 0};
+  for (int b = 0; b < sys_.num_bodies(); ++b)
+    if (sys_.bodies[b].mass > 0)
+      for (int k = 0; k < 3; ++k) scale[0] = std::max(scale[0], std::fabs(rhs_[7 * b + k]) / sys_.bodies[b].mass);
   double last_dx[2] = {0, 0};
   for (int it = 0; it < kMaxRefinements; ++it) {
     acceleration_residual(q, x, work_.data());
@@ -219,9 +227,10 @@ bool AugmentedSolver::refine_accelerations(const double* q, double t, double tol
     for (int b = 0; b < 2; ++b) {
       const double rho = it > 0 && last_dx[b] > 0 ? dx[b] / last_dx[b] : 1.0;
       const double error = rho <= 0.5 ? rho / (1 - rho) * dx[b] : INFINITY;
-      converged = converged && (dx[b] == 0 || error <= tolerance * xmax[b]);
+      const double allowed = tolerance * std::max(xmax[b], scale[b]);
+      converged = converged && (dx[b] == 0 || error <= allowed);
       // Not within the corrections left at this rate: the direct solve is cheaper.
-      hopeless = hopeless || (it > 0 && error * std::pow(rho, kMaxRefinements - 1 - it) > tolerance * xmax[b]);
+      hopeless = hopeless || (it > 0 && error * std::pow(rho, kMaxRefinements - 1 - it) > allowed);
       last_dx[b] = dx[b];
     }
     if (hopeless && !converged) return false;
