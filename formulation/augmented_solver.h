@@ -33,11 +33,12 @@ class AugmentedSolver {
                      double* a, double* lambda);
   // The accelerations of an output sample, without a factorization where one of a nearby state
   // suffices: iterative refinement x += K0^-1 (b - K x) on the last factorized acceleration
-  // matrix K0 (K x matrix-free: M a, Phi_q^T lambda and Phi_q a from the constraint rows; K is
-  // not assembled) (a KluSolver of its own, so that output samples do not change the factorizations
-  // the integration's own solves see), from x extrapolated through the last output samples (a
+  // matrix K0 (a KluSolver of its own, so that output samples do not change the factorizations
+  // the integration's own solves see; K x matrix-free, from the constraint rows: K is not
+  // assembled), from x extrapolated through the last output samples (a
   // polynomial in t, its degree chosen from the samples: choose_extrapolation_order), accepted
-  // when the estimated error of a and of lambda is below `tolerance` times their max norms; else the direct solve of accelerations(). Samples come in increasing
+  // when the estimated error of a and of lambda is below `tolerance` times their max norms (for
+  // a, at least the applied forces' |Q| / m); else the direct solve of accelerations(). Samples come in increasing
   // t; a call of accelerations() (a restart, possibly over a discontinuity) starts the
   // extrapolation afresh. docs/performance.md has the measurements.
   bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,

@@ -130,12 +130,6 @@ void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Ro
   }
 }
 
-void add_constraint_forces(const System& sys, const std::vector<int>& off, const std::vector<Row14>& rows,
-                           const double* lambda, double* out) {
-  for (size_t k = 0; k < sys.constraints.size(); ++k)
-    add_rows_transposed(sys.constraints[k], rows.data() + 3 * k, lambda + off[k], out);
-}
-
 void constraint_jacobian_times(const System& sys, const std::vector<int>& off, const double* q,
                                const double* v, double* out) {
   Row14 rows[3];

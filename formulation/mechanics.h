@@ -43,9 +43,6 @@ void add_constraint_forces(const System& sys, const std::vector<int>& offsets, c
 // 3 per constraint): computed once per residual evaluation (RunState's cache) and shared by the
 // rows that need Phi_q (Phi_q^T lambda, GGL's Phi_q^T mu, Phi_q v).
 void constraint_jacobian_rows(const System& sys, const double* q, std::vector<Row14>& rows);
-// out += Phi_q^T lambda, Phi_q from constraint_jacobian_rows().
-void add_constraint_forces(const System& sys, const std::vector<int>& offsets, const std::vector<Row14>& rows,
-                           const double* lambda, double* out);
 // Phi_q's structural entries row by row (those assemble_constraint_jacobian adds), for products
 // with the rows of constraint_jacobian_rows() without assembling Phi_q: stacked row i's entries
 // are e in [rowptr[i], rowptr[i + 1]), the value rows[source[i]](local[e]) at global column col[e].
@@ -54,8 +51,8 @@ struct ConstraintRowsPattern {
   std::vector<unsigned char> local;
 };
 ConstraintRowsPattern constraint_rows_pattern(const System& sys);
-// out += Phi_q^T lambda over the structural entries only: the same sums, in the same order, as
-// add_constraint_forces with rows (the entries left out are zeros).
+// out += Phi_q^T lambda, Phi_q from constraint_jacobian_rows(), over the structural entries only
+// (the entries left out are zeros): the same sums, in the same order, as over all 14 columns.
 void add_constraint_forces(const ConstraintRowsPattern& p, const std::vector<Row14>& rows, const double* lambda,
                            double* out);
 // out_q += Phi_q^T lambda and out_c = Phi_q a, in one pass over the rows.
