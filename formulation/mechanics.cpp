@@ -13,15 +13,17 @@ inline Vec4 p_of(const double* q, int b) { return Eigen::Map<const Vec4>(q + 7 *
 // Adds a local 14 x 14 block (rows and columns both local to bodies bi, bj).
 void add_local_block(int bi, int bj, const Mat14& m, int row0, int col0, bool with_r,
                      SparseAssembler& a) {
-  for (int c = 0; c < 14; ++c) {
-    const int gc = global_index(bi, bj, c);
-    if (gc < 0 || (!with_r && c % 7 < 3)) continue;
-    for (int r = 0; r < 14; ++r) {
-      const int gr = global_index(bi, bj, r);
-      if (gr < 0 || (!with_r && r % 7 < 3)) continue;
-      a.add(row0 + gr, col0 + gc, m(r, c));
-    }
+  // The local coordinates that enter (global index, skipping ground and, without r, the
+  // positions), once; then the same add() sequence, column by column.
+  int local[14], global[14], n = 0;
+  for (int l = 0; l < 14; ++l) {
+    const int g = global_index(bi, bj, l);
+    if (g < 0 || (!with_r && l % 7 < 3)) continue;
+    local[n] = l;
+    global[n++] = g;
   }
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r < n; ++r) a.add(row0 + global[r], col0 + global[c], m(local[r], local[c]));
 }
 }  // namespace
 
