@@ -22,19 +22,6 @@ Vec3 point_acceleration(const BodyPose& q, const BodyPose& v, const BodyPose& a,
   return a.r + B_matrix(q.p, s) * a.p + B_matrix(v.p, s) * v.p;
 }
 
-LocalState gather(const double* q, int bi, int bj) {
-  LocalState s;
-  if (bi >= 0) {
-    s.ri = Eigen::Map<const Vec3>(q + 7 * bi);
-    s.pi = Eigen::Map<const Vec4>(q + 7 * bi + 3);
-  }
-  if (bj >= 0) {
-    s.rj = Eigen::Map<const Vec3>(q + 7 * bj);
-    s.pj = Eigen::Map<const Vec4>(q + 7 * bj + 3);
-  }
-  return s;
-}
-
 Vec14 local_vector(const LocalState& s) {
   Vec14 y;
   y << s.ri, s.pi, s.rj, s.pj;

@@ -37,7 +37,20 @@ struct LocalState {
   Vec3 ri = Vec3::Zero(), rj = Vec3::Zero();
   Vec4 pi = Vec4(1, 0, 0, 0), pj = Vec4(1, 0, 0, 0);
 };
-LocalState gather(const double* q, int bi, int bj);
+// The two bodies' coordinates from the global q (ground: the origin, unrotated). Inline: every
+// constraint, force and sensor evaluation starts with it.
+inline LocalState gather(const double* q, int bi, int bj) {
+  LocalState s;
+  if (bi >= 0) {
+    s.ri = Eigen::Map<const Vec3>(q + 7 * bi);
+    s.pi = Eigen::Map<const Vec4>(q + 7 * bi + 3);
+  }
+  if (bj >= 0) {
+    s.rj = Eigen::Map<const Vec3>(q + 7 * bj);
+    s.pj = Eigen::Map<const Vec4>(q + 7 * bj + 3);
+  }
+  return s;
+}
 Vec14 gather_local(const double* x, int bi, int bj);  // local 14-vector (zeros for ground)
 // A LocalState as the local 14-vector [ri, pi, rj, pj], and back.
 Vec14 local_vector(const LocalState& s);
