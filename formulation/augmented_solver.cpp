@@ -194,20 +194,22 @@ void AugmentedSolver::acceleration_residual(const double* q, const double* x, do
 // iteration contracts by rho = |K0^-1 (K - K0)| per correction (small for nearby states); the
 // error left after a correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio
 // of successive corrections (per block, a and lambda). Accepted when that estimate is below
-// `tolerance` of the block's max norm (for a, at least of the applied forces' |Q| / m); a slow
-// (rho > 0.5) or diverging iteration is not.
+// `tolerance` of the block's max norm (for a, or the rounding of the applied forces, 1e3 eps
+// |Q| / m); a slow (rho > 0.5) or diverging iteration is not.
 bool AugmentedSolver::refine_accelerations(const double* q, double t, double tolerance) {
   const int n = nq_ + nc_;
   double* x = work2_.data();
   predict_accelerations(t, std::min(points_, history_size_), x);
   constraint_jacobian_rows(sys_, q, rows_);
-  // The accelerations' scale is at least that of the applied forces (|Q| / m, gravity for a body
-  // that it pulls): a mechanism at rest has a = 0 up to rounding, and a tolerance relative to
-  // that alone could never be met (every sample would fall back to the direct solve).
-  double scale[2] = {0, 0};
+  // The accelerations cannot be resolved below the rounding of the force balance, about eps |Q| / m
+  // (gravity for a body it pulls): a mechanism at rest has a = 0 up to that rounding, and a
+  // tolerance relative to |a| alone could never be met there (every sample would fall back to
+  // the direct solve). So a is accepted at that rounding (1e3 eps |Q| / m) when it is the larger.
+  double floor[2] = {0, 0};
   for (int b = 0; b < sys_.num_bodies(); ++b)
     if (sys_.bodies[b].mass > 0)
-      for (int k = 0; k < 3; ++k) scale[0] = std::max(scale[0], std::fabs(rhs_[7 * b + k]) / sys_.bodies[b].mass);
+      for (int k = 0; k < 3; ++k) floor[0] = std::max(floor[0], std::fabs(rhs_[7 * b + k]) / sys_.bodies[b].mass);
+  floor[0] *= 1e3 * 2.220446049250313e-16;
   double last_dx[2] = {0, 0};
   for (int it = 0; it < kMaxRefinements; ++it) {
     acceleration_residual(q, x, work_.data());
@@ -227,7 +229,7 @@ bool AugmentedSolver::refine_accelerations(const double* q, double t, double tol
     for (int b = 0; b < 2; ++b) {
       const double rho = it > 0 && last_dx[b] > 0 ? dx[b] / last_dx[b] : 1.0;
       const double error = rho <= 0.5 ? rho / (1 - rho) * dx[b] : INFINITY;
-      const double allowed = tolerance * std::max(xmax[b], scale[b]);
+      const double allowed = std::max(tolerance * xmax[b], floor[b]);
       converged = converged && (dx[b] == 0 || error <= allowed);
       // Not within the corrections left at this rate: the direct solve is cheaper.
       hopeless = hopeless || (it > 0 && error * std::pow(rho, kMaxRefinements - 1 - it) > allowed);

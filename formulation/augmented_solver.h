@@ -38,7 +38,7 @@ class AugmentedSolver {
   // assembled), from x extrapolated through the last output samples (a
   // polynomial in t, its degree chosen from the samples: choose_extrapolation_order), accepted
   // when the estimated error of a and of lambda is below `tolerance` times their max norms (for
-  // a, at least the applied forces' |Q| / m); else the direct solve of accelerations(). Samples come in increasing
+  // a, or 1e3 eps of the applied forces' |Q| / m, their rounding); else the direct solve of accelerations(). Samples come in increasing
   // t; a call of accelerations() (a restart, possibly over a discontinuity) starts the
   // extrapolation afresh. docs/performance.md has the measurements.
   bool output_accelerations(const std::vector<char>& modes, const double* q, const double* v,
