@@ -68,12 +68,6 @@ int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
 int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix jac, void* ud,
                 N_Vector, N_Vector, N_Vector) {
   auto* u = static_cast<UserData*>(ud);
-  const CscPattern& p = *u->pattern;
-  // The pattern, at every call (cheap, and whatever wrote the matrix since).
-  sunindextype* colptr = SUNSparseMatrix_IndexPointers(jac);
-  sunindextype* rowind = SUNSparseMatrix_IndexValues(jac);
-  for (int c = 0; c <= p.cols; ++c) colptr[c] = p.colptr[c];
-  for (int k = 0; k < p.nnz(); ++k) rowind[k] = p.rowind[k];
   try {
     return u->problem->jacobian(t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                                 SUNSparseMatrix_Data(jac));
@@ -188,13 +182,15 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.problem->error_test_mask(data(r.id));
   const CscPattern& pattern = r.problem->jacobian_pattern();
   r.jac = check(SUNSparseMatrix(r.n, r.n, std::max(1, pattern.nnz()), CSC_MAT, r.ctx), "SUNSparseMatrix");
-  // IDA zeroes the matrix before each Jacobian call; jacobian_fn writes its pattern and every
-  // value (SparseAssembler::begin_values zeroes them), so that pass over the matrix is skipped.
+  // The pattern once. IDA zeroes the matrix (pattern included) before each Jacobian call:
+  // jacobian_fn writes every value (SparseAssembler::begin_values zeroes them), so that pass over
+  // the matrix is skipped and the pattern stays.
+  std::copy(pattern.colptr.begin(), pattern.colptr.end(), SUNSparseMatrix_IndexPointers(r.jac));
+  std::copy(pattern.rowind.begin(), pattern.rowind.end(), SUNSparseMatrix_IndexValues(r.jac));
   r.jac->ops->zero = [](SUNMatrix) -> int { return 0; };
   r.ls = make_newton_linear_solver(pattern, o.reduced_newton ? r.problem->kinematic_rows() : 0, r.ctx);
   r.mem = check(IDACreate(r.ctx), "IDACreate");
   r.ud.problem = r.problem;
-  r.ud.pattern = &pattern;
   r.ud.mem = r.mem;
   r.ud.rtol = o.rtol;
   r.ud.atol = o.atol;

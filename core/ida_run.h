@@ -20,7 +20,6 @@ namespace mbdae::ida_detail {
 
 struct UserData {
   DaeProblem* problem;
-  const CscPattern* pattern;
   void* mem;
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
