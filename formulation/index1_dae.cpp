@@ -49,13 +49,9 @@ void Index1Dae::assemble(double t, double cj, const double* y, const double* yp)
 
 void Index1Dae::derivative_times(const double* y, const double* x, double* out) {
   MultibodyDae::derivative_times(y, x, out);
-  constraint_jacobian_rows(sys_, y, rows_);
   double* f3 = out + 2 * nq_;
-  for (size_t k = 0; k < sys_.constraints.size(); ++k) {
-    const Constraint& c = sys_.constraints[k];
-    const Vec14 xl = gather_local(x + nq_, c.bi, c.bj);
-    for (int r = 0; r < c.rows(); ++r) f3[offsets_[k] + r] = scale_ * rows_[3 * k + r].dot(xl);
-  }
+  constraint_jacobian_times(sys_, offsets_, y, x + nq_, f3);
+  for (int i = 0; i < nc_; ++i) f3[i] *= scale_;
 }
 
 void Index1Dae::error_test_mask(double* id) const {

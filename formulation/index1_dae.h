@@ -65,7 +65,6 @@ class Index1Dae : public MultibodyDae {
   BaumgarteParameters bg_;
   bool exact_gamma_q_;
   double inverse_penalty_ = 0.0;
-  std::vector<Row14> rows_;  // derivative_times' constraint Jacobian rows
 };
 
 }  // namespace mbdae
