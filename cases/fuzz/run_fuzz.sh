@@ -107,7 +107,12 @@ if [[ ${#todo[@]} -gt 0 ]]; then
   ' _ {} "${cxxflags[@]}"
 fi
 exe="$build/scene_loader_fuzz"
-newest=$(ls -t "${objects[@]}" | head -1)
+# The newest object, found without `ls -t | head` (under pipefail, head closing the pipe early
+# makes ls die of SIGPIPE once the list outgrows one pipe write, and the script exit 141).
+newest=${objects[0]}
+for o in "${objects[@]}"; do
+  if [[ "$o" -nt "$newest" ]]; then newest=$o; fi
+done
 if [[ ! -x "$exe" || "$newest" -nt "$exe" ]]; then
   "$cxx" "${san[@]}" -fsanitize=fuzzer "${objects[@]}" "${libs[@]}" -o "$exe"
 fi
@@ -121,6 +126,7 @@ status=0
   -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$artifacts/" -print_final_stats=1 "$@" || status=$?
 if [[ $status -ne 0 ]]; then
   echo "run_fuzz.sh: the fuzzer stopped with status $status; reproducer(s):" >&2
-  ls -t "$artifacts" | head -5 | sed "s|^|  $artifacts/|" >&2
+  shown=0
+  while read -r f && [[ $shown -lt 5 ]]; do echo "  $artifacts/$f" >&2; shown=$((shown + 1)); done < <(ls -t "$artifacts")
 fi
 exit $status
