@@ -1,18 +1,20 @@
-// Fused operations for SUNDIALS' serial N_Vector (issue 27): IDA's predictor and its
-// interpolation (IDAGetSolution, IDAGetDky: the root functions and every output sample) form
-// linear combinations of up to six history vectors. Without a fused operation SUNDIALS does one
-// pass over memory per vector (N_VScale, then N_VLinearSum per term); this one does a single pass,
-// with the same operations per element in the same order, so the results are bit for bit those
-// of SUNDIALS' own sequence (docs/performance.md).
+// mbdae's kernels for SUNDIALS' serial N_Vector (issue 27), bit for bit SUNDIALS' own results:
+// - a fused linear combination: IDA's predictor and its interpolation (IDAGetSolution, IDAGetDky:
+//   the root functions and every output sample) combine up to six history vectors; without a
+//   fused operation SUNDIALS makes one pass over memory per vector (N_VScale, then N_VLinearSum
+//   per term), this one a single pass with the same operations per element in the same order;
+// - the serial kernels IDA and IDAS spend their vector work in (linear sum, scale, constant, the
+//   weighted norms), SUNDIALS' own code compiled with this build's optimization: Debian builds
+//   libsundials without optimization (docs/performance.md, "SUNDIALS' kernels compiled").
 #pragma once
 
 #include <sundials/sundials_nvector.h>
 
 namespace mbdae {
 
-// Installs the fused operations in v's operation table; vectors cloned from v (IDA's own) inherit
-// them.
-void use_fused_operations(N_Vector v);
+// Installs these kernels in v's operation table; vectors cloned from v (IDA's own, IDAS's
+// sensitivities) inherit them.
+void use_vector_kernels(N_Vector v);
 
 // z = sum_i c[i] X[i] in one pass (N_VLinearCombination's contract; SUNDIALS' sequence where z
 // is one of X[1..]).

@@ -175,7 +175,7 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   if (!r.ctx) throw SolveError("integration_failed", "cannot create a SUNDIALS context");
   for (N_Vector* v : {&r.y, &r.yp, &r.id, &r.ys, &r.yps}) {
     *v = check(N_VNew_Serial(r.n, r.ctx), "N_VNew_Serial");
-    use_fused_operations(*v);  // IDA's vectors are clones of y: they inherit it
+    use_vector_kernels(*v);  // IDA's vectors are clones of y: they inherit it
   }
   std::memcpy(data(r.y), y0.data(), r.n * sizeof(double));
   std::memcpy(data(r.yp), yp0.data(), r.n * sizeof(double));

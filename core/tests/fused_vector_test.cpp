@@ -1,5 +1,7 @@
-// The fused linear combination (core/fused_vector.h) against SUNDIALS' own sequence without it:
-// bit for bit, for 1 to 7 vectors, coefficients +-1 among them, and z aliasing an input.
+// mbdae's vector kernels (core/fused_vector.h) against SUNDIALS' own serial operations, bit for
+// bit: the fused linear combination for 1 to 7 vectors, coefficients +-1 among them, z aliasing an
+// input; the linear sum for every special case of SUNDIALS' (coefficients 1, -1, equal, opposite,
+// z aliasing x or y), scale, constant and the weighted norms.
 #include "core/fused_vector.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace mbdae {
@@ -68,11 +72,70 @@ TEST(FusedVector, LinearCombinationIntoOneOfItsInputs) {
   }
 }
 
+// Runs op on two equal sets of count vectors, one with mbdae's kernels and one with SUNDIALS'
+// own, and compares every vector afterwards.
+template <class Op>
+void expect_same(int count, const char* what, Op op) {
+  const int n = 211;
+  Vectors a(count, n), b(count, n);  // same seed: equal contents
+  for (N_Vector v : a.v) use_vector_kernels(v);
+  ASSERT_EQ(b.v[0]->ops->nvlinearsum, &N_VLinearSum_Serial);
+  const double ra = op(a.v), rb = op(b.v);
+  EXPECT_EQ(std::memcmp(&ra, &rb, sizeof ra), 0) << what << ": " << ra << " against " << rb;
+  for (int i = 0; i < count; ++i) EXPECT_TRUE(same_bits(a.v[i], b.v[i])) << what << ", vector " << i;
+}
+
+TEST(FusedVector, SerialKernelsAreSundialsOwnBitForBit) {
+  const double other = 0.7303, another = -2.917;
+  const std::pair<double, double> coefficients[] = {
+      {1, 1}, {1, -1}, {-1, 1}, {1, other}, {other, 1}, {-1, other}, {other, -1},
+      {other, other}, {other, -other}, {other, another}, {0, other}, {other, 0}, {-1, -1}};
+  for (auto [a, b] : coefficients) {
+    const std::string ab = std::to_string(a) + ", " + std::to_string(b);
+    expect_same(3, ("linear sum z = " + ab).c_str(), [=](std::vector<N_Vector>& v) {
+      N_VLinearSum(a, v[0], b, v[1], v[2]);
+      return 0.0;
+    });
+    expect_same(2, ("linear sum into y, " + ab).c_str(), [=](std::vector<N_Vector>& v) {
+      N_VLinearSum(a, v[0], b, v[1], v[1]);
+      return 0.0;
+    });
+    expect_same(2, ("linear sum into x, " + ab).c_str(), [=](std::vector<N_Vector>& v) {
+      N_VLinearSum(a, v[0], b, v[1], v[0]);
+      return 0.0;
+    });
+  }
+  for (double c : {1.0, -1.0, other}) {
+    expect_same(2, "scale", [=](std::vector<N_Vector>& v) {
+      N_VScale(c, v[0], v[1]);
+      return 0.0;
+    });
+    expect_same(1, "scale in place", [=](std::vector<N_Vector>& v) {
+      N_VScale(c, v[0], v[0]);
+      return 0.0;
+    });
+  }
+  expect_same(1, "constant", [=](std::vector<N_Vector>& v) {
+    N_VConst(other, v[0]);
+    return 0.0;
+  });
+  expect_same(2, "weighted rms norm", [](std::vector<N_Vector>& v) { return N_VWrmsNorm(v[0], v[1]); });
+  expect_same(2, "weighted square sum", [](std::vector<N_Vector>& v) { return N_VWSqrSumLocal(v[0], v[1]); });
+  auto masked = [](std::vector<N_Vector>& v, bool local) {
+    for (int k = 0; k < NV_LENGTH_S(v[2]); ++k) NV_Ith_S(v[2], k) = k % 3 == 0 ? 0.0 : 1.0;
+    return local ? N_VWSqrSumMaskLocal(v[0], v[1], v[2]) : N_VWrmsNormMask(v[0], v[1], v[2]);
+  };
+  expect_same(3, "masked weighted rms norm", [&](std::vector<N_Vector>& v) { return masked(v, false); });
+  expect_same(3, "masked weighted square sum", [&](std::vector<N_Vector>& v) { return masked(v, true); });
+}
+
 TEST(FusedVector, ClonesInheritTheOperation) {
   Vectors in(1, 4);
-  use_fused_operations(in.v[0]);
+  use_vector_kernels(in.v[0]);
   N_Vector clone = N_VClone(in.v[0]);
   EXPECT_EQ(clone->ops->nvlinearcombination, &fused_linear_combination);
+  EXPECT_EQ(clone->ops->nvlinearsum, in.v[0]->ops->nvlinearsum);
+  EXPECT_NE(clone->ops->nvlinearsum, &N_VLinearSum_Serial);
   N_VDestroy(clone);
 }
 
