@@ -42,7 +42,8 @@ def main():
     title = a.title or meta.get("label", a.csv)
     if meta:
         title += ", t in [0, %g] s%s" % (meta["t_end"], " (shortened)" if meta.get("t_end_shortened") else "")
-        title += "; reference index3 rtol %g atol %g" % (meta["reference"]["rtol"], meta["reference"]["atol"])
+        ref = meta["reference"]
+        title += "; reference %s rtol %g atol %g" % (ref.get("formulation", "index3"), ref["rtol"], ref["atol"])
     forms = []
     for r in rows:
         if r["formulation"] not in forms:
