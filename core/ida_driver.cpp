@@ -12,7 +12,7 @@
 
 #include "core/errors.h"
 #include "core/finite_check.h"
-#include "core/fused_vector.h"
+#include "core/vector_kernels.h"
 #include "core/ida_run.h"
 #include "core/reduced_linear_solver.h"
 #include "core/sundials_compat.h"

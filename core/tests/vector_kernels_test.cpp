@@ -1,8 +1,8 @@
-// mbdae's vector kernels (core/fused_vector.h) against SUNDIALS' own serial operations, bit for
+// mbdae's vector kernels (core/vector_kernels.h) against SUNDIALS' own serial operations, bit for
 // bit: the fused linear combination for 1 to 7 vectors, coefficients +-1 among them, z aliasing an
 // input; the linear sum for every special case of SUNDIALS' (coefficients 1, -1, equal, opposite,
 // z aliasing x or y), scale, constant and the weighted norms.
-#include "core/fused_vector.h"
+#include "core/vector_kernels.h"
 
 #include <gtest/gtest.h>
 #include <nvector/nvector_serial.h>
@@ -46,7 +46,7 @@ bool same_bits(N_Vector a, N_Vector b) {
   return std::memcmp(NV_DATA_S(a), NV_DATA_S(b), NV_LENGTH_S(a) * sizeof(double)) == 0;
 }
 
-TEST(FusedVector, LinearCombinationIsSundialsSequenceBitForBit) {
+TEST(VectorKernels, LinearCombinationIsSundialsSequenceBitForBit) {
   const int n = 301;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-2.0, 2.0);
@@ -61,7 +61,7 @@ TEST(FusedVector, LinearCombinationIsSundialsSequenceBitForBit) {
   }
 }
 
-TEST(FusedVector, LinearCombinationIntoOneOfItsInputs) {
+TEST(VectorKernels, LinearCombinationIntoOneOfItsInputs) {
   const int n = 57, nvec = 5;
   double c[nvec] = {0.3, -1.7, 1.0, 2.5, -0.25};
   for (int alias : {0, 2}) {
@@ -85,7 +85,7 @@ void expect_same(int count, const char* what, Op op) {
   for (int i = 0; i < count; ++i) EXPECT_TRUE(same_bits(a.v[i], b.v[i])) << what << ", vector " << i;
 }
 
-TEST(FusedVector, SerialKernelsAreSundialsOwnBitForBit) {
+TEST(VectorKernels, SerialKernelsAreSundialsOwnBitForBit) {
   const double other = 0.7303, another = -2.917;
   const std::pair<double, double> coefficients[] = {
       {1, 1}, {1, -1}, {-1, 1}, {1, other}, {other, 1}, {-1, other}, {other, -1},
@@ -129,7 +129,7 @@ TEST(FusedVector, SerialKernelsAreSundialsOwnBitForBit) {
   expect_same(3, "masked weighted square sum", [&](std::vector<N_Vector>& v) { return masked(v, true); });
 }
 
-TEST(FusedVector, ClonesInheritTheOperation) {
+TEST(VectorKernels, ClonesInheritTheOperation) {
   Vectors in(1, 4);
   use_vector_kernels(in.v[0]);
   N_Vector clone = N_VClone(in.v[0]);

@@ -1,4 +1,4 @@
-#include "core/fused_vector.h"
+#include "core/vector_kernels.h"
 
 #include <nvector/nvector_serial.h>
 
