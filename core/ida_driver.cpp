@@ -12,10 +12,10 @@
 
 #include "core/errors.h"
 #include "core/finite_check.h"
-#include "core/vector_kernels.h"
 #include "core/ida_run.h"
 #include "core/reduced_linear_solver.h"
 #include "core/sundials_compat.h"
+#include "core/vector_kernels.h"
 
 namespace mbdae {
 namespace ida_detail {
