@@ -115,14 +115,17 @@ double wrms_norm_mask(N_Vector x, N_Vector w, N_Vector id) {
 }  // namespace
 
 // SUNDIALS' sequence without a fused operation: z = c0 X0 (N_VScale), then z += c_i X_i
-// (N_VLinearSum with b = 1 and y = z: axpy). Kept for the aliasing it allows (z one of X[1..]).
+// (N_VLinearSum with b = 1 and y = z: axpy). Kept for the aliasing it allows (z one of X[1..])
+// and for more than 7 vectors (IDA passes at most 6).
 static void sundials_sequence(int nvec, double* c, N_Vector* X, N_Vector z) {
   scale(c[0], X[0], z);
   for (int i = 1; i < nvec; ++i) linear_sum(c[i], X[i], 1.0, z, z);
 }
 
 // z = sum_i c[i] X[i] for N vectors known at compile time: the sum over i unrolled, so that the
-// loop over the elements is a plain (vectorizable) one; per element the same order as below.
+// loop over the elements is a plain (vectorizable) one. Per element the same products and sums,
+// in the same order, as sundials_sequence (c * x is exact for c = +-1, where SUNDIALS copies,
+// negates or adds instead of multiplying).
 template <int N>
 static int combination(const double* c, N_Vector* X, N_Vector z) {
   const sunindextype n = NV_LENGTH_S(z);
@@ -139,45 +142,21 @@ static int combination(const double* c, N_Vector* X, N_Vector z) {
 
 int fused_linear_combination(int nvec, double* c, N_Vector* X, N_Vector z) {
   if (nvec < 1) return -1;
-  for (int i = 1; i < nvec; ++i)
-    if (X[i] == z) {
-      sundials_sequence(nvec, c, X, z);
-      return 0;
-    }
-  const sunindextype n = NV_LENGTH_S(z);
-  double* zd = NV_DATA_S(z);
-  const double* x0 = NV_DATA_S(X[0]);
-  // Per element the same products and sums, in the same order, as sundials_sequence (c * x is
-  // exact for c = +-1, where SUNDIALS copies, negates or adds instead of multiplying).
+  // z one of X[1..]: SUNDIALS' sequence overwrites that input (z = c0 X0) before it adds it.
+  bool aliased = false;
+  for (int i = 1; i < nvec; ++i) aliased = aliased || X[i] == z;
+  if (aliased || nvec > 7) {
+    sundials_sequence(nvec, c, X, z);
+    return 0;
+  }
   switch (nvec) {
-    case 1:
-      for (sunindextype k = 0; k < n; ++k) zd[k] = c[0] * x0[k];
-      return 0;
-    case 2: {
-      const double* x1 = NV_DATA_S(X[1]);
-      for (sunindextype k = 0; k < n; ++k) zd[k] = c[0] * x0[k] + c[1] * x1[k];
-      return 0;
-    }
+    case 1: return combination<1>(c, X, z);
+    case 2: return combination<2>(c, X, z);
     case 3: return combination<3>(c, X, z);
     case 4: return combination<4>(c, X, z);
     case 5: return combination<5>(c, X, z);
-    case 6: return combination<6>(c, X, z);
-    case 7: return combination<7>(c, X, z);
-    default: {
-      constexpr int kMax = 16;  // IDA's history holds at most 6 vectors
-      if (nvec > kMax) {
-        sundials_sequence(nvec, c, X, z);
-        return 0;
-      }
-      const double* x[kMax];
-      for (int i = 0; i < nvec; ++i) x[i] = NV_DATA_S(X[i]);
-      for (sunindextype k = 0; k < n; ++k) {
-        double s = c[0] * x0[k];
-        for (int i = 1; i < nvec; ++i) s += c[i] * x[i][k];
-        zd[k] = s;
-      }
-      return 0;
-    }
+    case 6: return combination<6>(c, X, z);  // IDA's history holds at most 6 vectors
+    default: return combination<7>(c, X, z);
   }
 }
 
