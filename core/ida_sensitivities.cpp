@@ -6,6 +6,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "core/finite_check.h"
 #include "core/ida_run.h"
 
 namespace mbdae::ida_detail {
@@ -49,12 +50,12 @@ void sensitivity_weight_floor(UserData* u, N_Vector y, N_Vector w) {
     const double* yd = N_VGetArrayPointer(y);
     u->state_size = 0;
     for (int i = 0; i < n; ++i)
-      if (u->id[i] > 0) u->state_size = std::fmax(u->state_size, std::fabs(yd[i]));
+      if (u->id[i] > 0) u->state_size = max_num(u->state_size, std::fabs(yd[i]));
     u->state_y.assign(yd, yd + n);  // sized once: no allocation after the first call
     return;
   }
   for (int i = 0; i < n && !u->state_y.empty(); ++i) {
-    const double floor = kSensitivityNoise * std::fmax(u->state_size, std::fabs(u->state_y[i]));
+    const double floor = kSensitivityNoise * max_num(u->state_size, std::fabs(u->state_y[i]));
     if (floor > 0 && wd[i] * floor > 1) wd[i] = 1 / floor;
   }
 }

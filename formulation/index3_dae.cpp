@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/finite_check.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -50,15 +51,15 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
 void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* w) const {
   // Tolerances of q times (h/T)^2, never below the rounding of the coordinates (1e3 eps of the
   // model's positions, 1e3 eps for Euler parameters), never looser than the plain test.
-  const double r = abs_tol_.time / h, f = std::fmax(1.0, r * r);
+  const double r = abs_tol_.time / h, f = max_num(1.0, r * r);
   double rmax = abs_tol_.length;
-  for (int i = 0; i < nq_; i += 7) rmax = std::fmax(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
+  for (int i = 0; i < nq_; i += 7) rmax = max_num(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
   const double w_length = 1.0 / (kRoundingFloor * rmax), w_rotation = 1.0 / kRoundingFloor;
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {
-    const double wanted = w[i] * f, floor = std::fmax(w[i], i % 7 < 3 ? w_length : w_rotation);
+    const double wanted = w[i] * f, floor = max_num(w[i], i % 7 < 3 ? w_length : w_rotation);
     floored += wanted > floor;
-    w[i] = std::fmin(wanted, floor);
+    w[i] = min_num(wanted, floor);
   }
   count_floor(floored);
 }

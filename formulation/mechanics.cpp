@@ -1,5 +1,6 @@
 #include "formulation/mechanics.h"
 
+#include "core/finite_check.h"
 #include "formulation/sensors.h"
 
 #include <cmath>
@@ -145,7 +146,7 @@ void constraint_jacobian_times(const System& sys, const std::vector<int>& off, c
 
 double max_abs(const double* x, int n) {
   double m = 0;
-  for (int i = 0; i < n; ++i) m = std::fmax(m, std::fabs(x[i]));
+  for (int i = 0; i < n; ++i) m = max_num(m, std::fabs(x[i]));
   return m;
 }
 

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "core/errors.h"
+#include "core/finite_check.h"
 #include "formulation/constraint_rates.h"
 #include "formulation/mechanics.h"
 
@@ -15,7 +16,7 @@ MultibodyDae::MultibodyDae(const System& sys)
   state_.modes = initial_modes(sys, sys.q0.data(), 0.0);
   state_.turns = initial_turns(sys);
   aug_.turns = &state_.turns;
-  for (const auto& b : sys.bodies) mass_scale_ = std::fmax(mass_scale_, b.mass);
+  for (const auto& b : sys.bodies) mass_scale_ = max_num(mass_scale_, b.mass);
   for (size_t k = 0; k < sys.forces.size(); ++k)
     if (force_has_switch(sys.forces[k])) switch_forces_.push_back(static_cast<int>(k));
   switch_offsets_.assign(switch_forces_.size(), 0.0);
@@ -110,22 +111,22 @@ std::string MultibodyDae::component_name(int i) const {
 
 double MultibodyDae::position_noise(const double* y) const {
   double qmax = 1.0;
-  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
+  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
   return 1e3 * 2.22e-16 * qmax;
 }
 
 double MultibodyDae::position_atol(const double* y, double atol) const {
   double qmax = 0;
-  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
-  return std::fmax(atol, 10 * 2.22e-16 * qmax);
+  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
+  return max_num(atol, 10 * 2.22e-16 * qmax);
 }
 
 double MultibodyDae::velocity_atol(double h, const double* y, double atol) const {
   double qmax = 0, vmax = 0;
-  for (int i = 0; i < nq_; ++i) qmax = std::fmax(qmax, std::fabs(y[i]));
-  for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
+  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
+  for (int i = nq_; i < 2 * nq_; ++i) vmax = max_num(vmax, std::fabs(y[i]));
   const double step = newton_cj_ > 0 ? 1.0 / newton_cj_ : h;
-  return std::fmax(atol, 10 * 2.22e-16 * std::fmax(vmax, qmax / step));
+  return max_num(atol, 10 * 2.22e-16 * max_num(vmax, qmax / step));
 }
 
 void MultibodyDae::position_weights(const double* y, double rtol, double aq, double* w) const {
@@ -150,21 +151,21 @@ void MultibodyDae::state_weights(double h, const double* y, double rtol, double 
 
 void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w) const {
   if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
-  const double f = std::fmax(1.0, abs_tol_.span / h);
+  const double f = max_num(1.0, abs_tol_.span / h);
   double rmax = abs_tol_.length, vmax = abs_tol_.length / abs_tol_.time;
-  for (int i = 0; i < nq_; i += 7) rmax = std::fmax(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
-  for (int i = nq_; i < 2 * nq_; ++i) vmax = std::fmax(vmax, std::fabs(y[i]));
+  for (int i = 0; i < nq_; i += 7) rmax = max_num(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
+  for (int i = nq_; i < 2 * nq_; ++i) vmax = max_num(vmax, std::fabs(y[i]));
   const double e = kSpanRoundingFloor;
   const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
-  const double w_velocity = 1.0 / (e * std::fmax(vmax, rmax / noise_step));
-  const double w_rate = 1.0 / (e * std::fmax(1.0, 1.0 / noise_step));
+  const double w_velocity = 1.0 / (e * max_num(vmax, rmax / noise_step));
+  const double w_rate = 1.0 / (e * max_num(1.0, 1.0 / noise_step));
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {
     const bool euler = i % 7 >= 3;
-    const double wanted = w[i] * f, floor = std::fmax(w[i], euler ? w_rotation : w_length);
+    const double wanted = w[i] * f, floor = max_num(w[i], euler ? w_rotation : w_length);
     floored += wanted > floor;
-    w[i] = std::fmin(wanted, floor);
-    w[nq_ + i] = std::fmin(w[nq_ + i] * f, std::fmax(w[nq_ + i], euler ? w_rate : w_velocity));
+    w[i] = min_num(wanted, floor);
+    w[nq_ + i] = min_num(w[nq_ + i] * f, max_num(w[nq_ + i], euler ? w_rate : w_velocity));
   }
   count_floor(floored);
 }
@@ -230,12 +231,12 @@ double MultibodyDae::initial_step(double, const double* y, const double* yp, dou
 void MultibodyDae::after_step(double t_in, const double* y) {
   const double t = input_time(t_in);
   constraint_values(sys_, offsets_, y, t, stat_work_.data());
-  state_.statistics.max_position_violation = std::fmax(state_.statistics.max_position_violation, max_abs(stat_work_.data(), nc_));
+  state_.statistics.max_position_violation = max_num(state_.statistics.max_position_violation, max_abs(stat_work_.data(), nc_));
   velocity_constraint_values(sys_, offsets_, y, y + nq_, t, stat_work_.data());
-  state_.statistics.max_velocity_violation = std::fmax(state_.statistics.max_velocity_violation, max_abs(stat_work_.data(), nc_));
+  state_.statistics.max_velocity_violation = max_num(state_.statistics.max_velocity_violation, max_abs(stat_work_.data(), nc_));
   for (int b = 0; b < sys_.num_bodies(); ++b) {
     const double n = Eigen::Map<const Vec4>(y + 7 * b + 3).norm();
-    state_.statistics.max_norm_drift = std::fmax(state_.statistics.max_norm_drift, std::fabs(n - 1.0));
+    state_.statistics.max_norm_drift = max_num(state_.statistics.max_norm_drift, std::fabs(n - 1.0));
   }
   update_turns(sys_, y, y + nq_, t, state_.turns);
 }
@@ -294,7 +295,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
   if (project && state_.output_failure.empty()) {
     if (violation > 1e-14) {
       const PositionSolveResult r = aug_.positions(q.data(), t, 1e-14, 5);
-      if (!(r.residual <= std::fmax(1e-14, position_noise(q.data())))) {
+      if (!(r.residual <= max_num(1e-14, position_noise(q.data())))) {
         std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the position constraints did not converge (max |Phi| %.3g after %d iterations)",
                       t_in, r.residual, r.iterations);
         state_.output_failure = buf;
@@ -302,7 +303,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
     }
     velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
     double vmax = 1.0;
-    for (int i = 0; i < nq_; ++i) vmax = std::fmax(vmax, std::fabs(v[i]));
+    for (int i = 0; i < nq_; ++i) vmax = max_num(vmax, std::fabs(v[i]));
     if (state_.output_failure.empty() && max_abs(out_phi_.data(), nc_) > 1e-14 * vmax && !aug_.velocities(q.data(), t, v.data())) {
       std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the velocity constraints failed (singular constraint Jacobian)", t_in);
       state_.output_failure = buf;
