@@ -42,34 +42,42 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
   follow(*base_);
   if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
   for (size_t i = 0; i < twins_.size(); ++i) {
-    int flag = add_state_terms(t, y, yp, twins_[i], s[i], sp[i], r[i]);
-    if (flag == 0) flag = add_parameter_term(t, y, yp, twins_[i], r[i]);
+    base_->derivative_times(y, sp[i], r[i]);
+    int flag = 0;
+    if (exact_) {
+      add_assembled_state_term(s[i], r[i]);
+      flag = add_parameter_term(t, y, yp, twins_[i], r[i]);
+    } else {
+      flag = add_difference_terms(t, y, yp, twins_[i], s[i], r[i]);
+    }
     if (flag != 0) return flag;
   }
   return 0;
 }
 
-// r = F_y s + F_y' s': F_y' s' exactly (the formulation's derivative_times), F_y s by a central
-// difference along s or, after fall_back(), by A0.
-int TwinSensitivities::add_state_terms(double t, const double* y, const double* yp, const ParameterTwins& p,
-                                       const double* s, const double* sp, double* r) {
+// r += F_y s + F_p = [F+(y + d s, y') - F-(y - d s, y')] / (2 d): the twins' central difference
+// along the state's direction s and the parameter together, two residuals.
+int TwinSensitivities::add_difference_terms(double t, const double* y, const double* yp, ParameterTwins& p,
+                                            const double* s, double* r) {
   const int n = run_.size();
-  base_->derivative_times(y, sp, r);
-  if (exact_) {
-    const CscPattern& pat = base_->jacobian_pattern();
-    for (int c = 0; c < n; ++c)
-      for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[pat.rowind[k]] += a0_[k] * s[c];
-    return 0;
-  }
   for (int sign = 1; sign >= -1; sign -= 2) {
+    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+    follow(twin);
     for (int k = 0; k < n; ++k) yt_[k] = y[k] + sign * p.delta * s[k];
-    if (const int flag = base_->residual(t, yt_.data(), yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
+    if (const int flag = twin.residual(t, yt_.data(), yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
   }
   for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
   return 0;
 }
 
-// r += F_p by the twins at the same (y, y').
+// r += A0 s (after fall_back()).
+void TwinSensitivities::add_assembled_state_term(const double* s, double* r) const {
+  const CscPattern& pat = base_->jacobian_pattern();
+  for (int c = 0; c < run_.size(); ++c)
+    for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[pat.rowind[k]] += a0_[k] * s[c];
+}
+
+// r += F_p by the twins at the same (y, y') (after fall_back()).
 int TwinSensitivities::add_parameter_term(double t, const double* y, const double* yp, ParameterTwins& p, double* r) {
   for (int sign = 1; sign >= -1; sign -= 2) {
     MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;

@@ -4,18 +4,18 @@
 // same coordinates and equations), whose modes and turns follow the run's. The sensitivity
 // equations' residual is
 //
-//   F_y s + F_y' s' + F_p  =  F_y s  +  F_y' s'  +  [F+(y, y') - F-(y, y')] / (2 d),
+//   F_y s + F_y' s' + F_p  =  F_y' s'  +  [F+(y + d s, y') - F-(y - d s, y')] / (2 d),
 //
 // F_y' s' exact, from the formulation (MultibodyDae::derivative_times: every formulation's F is
-// affine in y', F_y' holds the identity, the mass matrix and index1's Phi_q); F_p a central
-// difference over the twins at the same (y, y'): the terms that do not depend on p are evaluated
-// bit for bit alike in both twins and cancel, so its rounding is that of the terms p enters, and
-// no parameter needs code of its own (force parameters, masses, hardpoints, gravity, expression
-// constants alike). F_y s is a central difference of the run's own model along s, two residuals
-// per parameter; where IDA fails with it (its rounding, eps |y| / d, is 1e5 times that of the
-// state: Dynamics I with the wheel mass at the ground step's restart), fall_back() turns to
-// A0 s, A0 = F_y the formulation's own Newton matrix at cj = 0 (exact, one assembly per call
-// for all parameters, on a copy of the run's DAE), and the driver retries from the last step.
+// affine in y', F_y' holds the identity, the mass matrix and index1's Phi_q); F_y s + F_p one
+// central difference of the twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), two
+// residuals per parameter, and no parameter needs code of its own (force parameters, masses,
+// hardpoints, gravity, expression constants alike). Where IDA fails with it (its rounding,
+// eps |F| / d, is 1e5 times that of the state: Dynamics I with the wheel mass at the ground
+// step's restart), fall_back() turns to A0 s, A0 = F_y the formulation's own Newton matrix at
+// cj = 0 (exact, one assembly per call for all parameters, on a copy of the run's DAE), plus F_p
+// as the twins' difference at the same (y, y') (the terms that do not depend on p are evaluated
+// bit for bit alike in both twins and cancel), and the driver retries from the last step.
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 #pragma once
@@ -51,7 +51,7 @@ class TwinSensitivities : public SensitivityProblem {
   void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
   void set_segment(double t_start, double t_end) override;
   bool in_error_test() const override { return in_error_test_; }
-  // From central differences of F_y s to the Newton matrix's A0 (exact, dearer): once.
+  // From the twins' central differences to the Newton matrix's A0 (exact, dearer): once.
   bool fall_back() override {
     if (exact_) return false;
     exact_ = true;
@@ -68,8 +68,9 @@ class TwinSensitivities : public SensitivityProblem {
 
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
-  int add_state_terms(double t, const double* y, const double* yp, const ParameterTwins& p, const double* s,
-                      const double* sp, double* r);
+  int add_difference_terms(double t, const double* y, const double* yp, ParameterTwins& p, const double* s,
+                           double* r);
+  void add_assembled_state_term(const double* s, double* r) const;
   int add_parameter_term(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
 
   MultibodyDae& run_;
@@ -77,7 +78,7 @@ class TwinSensitivities : public SensitivityProblem {
   std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
-  bool exact_ = false;  // A0 = F_y assembled (after fall_back), else F_y s by differences
+  bool exact_ = false;  // A0 = F_y assembled (after fall_back), else F_y s + F_p by one difference
   std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
   std::string failure_;
