@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/klu_solve_one.h"
+
 namespace mbdae {
 
 namespace {
@@ -94,7 +96,8 @@ bool KluSolver::factor(const double* values) {
 
 bool KluSolver::solve(double* b) {
   if (!numeric_) return false;
-  return klu_solve(symbolic_, numeric_, pattern_.rows, 1, b, &common_) != 0;
+  klu_solve_one(*symbolic_, *numeric_, b);
+  return true;
 }
 
 double KluSolver::condest() {
