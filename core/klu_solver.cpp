@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/klu_solve_one.h"
+#include "core/klu_kernels.h"
 
 namespace mbdae {
 
@@ -81,8 +81,8 @@ bool KluSolver::factor(const double* values) {
     // degraded relative to the last fresh one: the absolute ratio of a multibody saddle-point
     // matrix can be tiny by nature (massless links, mixed units: 1e-15 for the suspension's
     // Newton matrix), so an absolute test alone would refactor from scratch every time.
-    if (klu_refactor(pattern_.colptr.data(), pattern_.rowind.data(), values_.data(), symbolic_,
-                     numeric_, &common_) &&
+    if (klu_refactor_scaled(pattern_.colptr.data(), pattern_.rowind.data(), values_.data(), *symbolic_,
+                            *numeric_, common_) &&
         klu_rcond(symbolic_, numeric_, &common_) &&
         (common_.rcond > 1e-14 || common_.rcond > 1e-3 * fresh_rcond_))
       return true;

@@ -1,10 +1,12 @@
-#include "core/klu_solve_one.h"
+#include "core/klu_kernels.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace mbdae {
@@ -59,6 +61,53 @@ int expect_same_solutions(Csc a, int scale, int btf, std::mt19937& rng) {
   return blocks;
 }
 
+// klu_refactor and klu_refactor_scaled of new values on the same pattern, each on its own
+// factorization of the old values: the factors, the off-diagonal blocks and the row scale equal
+// bit for bit. A zero pivot: both refuse.
+bool expect_same_refactorization(Csc a, const std::vector<double>& new_values, int btf) {
+  klu_common common;
+  klu_defaults(&common);
+  common.btf = btf;
+  klu_symbolic* s = klu_analyze(a.n, a.colptr.data(), a.rowind.data(), &common);
+  EXPECT_NE(s, nullptr);
+  klu_numeric* theirs = s ? klu_factor(a.colptr.data(), a.rowind.data(), a.values.data(), s, &common) : nullptr;
+  klu_numeric* ours = s ? klu_factor(a.colptr.data(), a.rowind.data(), a.values.data(), s, &common) : nullptr;
+  EXPECT_TRUE(theirs && ours);
+  if (!theirs || !ours) return false;
+  std::vector<double> v = new_values;
+  const bool ok_theirs = klu_refactor(a.colptr.data(), a.rowind.data(), v.data(), s, theirs, &common);
+  const bool ok_ours = klu_refactor_scaled(a.colptr.data(), a.rowind.data(), v.data(), *s, *ours, common);
+  EXPECT_EQ(ok_theirs, ok_ours);
+  if (ok_theirs && ok_ours) {
+    const auto same = [](const void* x, const void* y, size_t bytes) { return std::memcmp(x, y, bytes) == 0; };
+    EXPECT_TRUE(same(theirs->Udiag, ours->Udiag, a.n * sizeof(double)));
+    EXPECT_TRUE(same(theirs->Rs, ours->Rs, a.n * sizeof(double)));
+    EXPECT_TRUE(same(theirs->Offx, ours->Offx, theirs->nzoff * sizeof(double)));
+    // Every column of every block's L and U (their values follow the column's row indices,
+    // aligned to a double: KLU's packing; the padding between is not compared).
+    for (int b = 0; b < s->nblocks; ++b)
+      for (int k = s->R[b]; k < s->R[b + 1] && s->R[b + 1] - s->R[b] > 1; ++k)
+        for (auto [start, len] : {std::pair{theirs->Lip[k], theirs->Llen[k]}, std::pair{theirs->Uip[k], theirs->Ulen[k]}}) {
+          const size_t skip = start + (sizeof(int) * len + sizeof(double) - 1) / sizeof(double);
+          EXPECT_TRUE(same(static_cast<double*>(theirs->LUbx[b]) + skip, static_cast<double*>(ours->LUbx[b]) + skip,
+                           len * sizeof(double)))
+              << "block " << b << " column " << k;
+        }
+  }
+  klu_free_numeric(&theirs, &common);
+  klu_free_numeric(&ours, &common);
+  klu_free_symbolic(&s, &common);
+  return ok_theirs;
+}
+
+// New values on a's pattern: each entry moved by up to 30 % (the diagonal kept dominant).
+std::vector<double> perturbed(const Csc& a, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.7, 1.3);
+  std::vector<double> v = a.values;
+  for (double& x : v) x *= u(rng);
+  return v;
+}
+
 // A sparse matrix with a dominant diagonal and random couplings of mixed magnitudes.
 std::vector<double> random_sparse(int n, double density, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0), p(0.0, 1.0);
@@ -70,15 +119,26 @@ std::vector<double> random_sparse(int n, double density, std::mt19937& rng) {
   return a;
 }
 
-TEST(KluSolveOne, IsKluSolveBitForBitWithAndWithoutRowScaling) {
+TEST(KluKernels, SolveIsKluSolveBitForBitWithAndWithoutRowScaling) {
   std::mt19937 rng(7);
   const Csc a = to_csc(random_sparse(80, 0.06, rng), 80);
   for (int scale : {2, 1, 0}) expect_same_solutions(a, scale, 1, rng);
 }
 
+TEST(KluKernels, RefactorizationIsKluRefactorBitForBit) {
+  std::mt19937 rng(5);
+  const Csc a = to_csc(random_sparse(80, 0.06, rng), 80);
+  for (int btf : {1, 0}) expect_same_refactorization(a, perturbed(a, rng), btf);
+  // An exactly zero pivot in the new values: the first column's only entry.
+  Csc z = to_csc(random_sparse(30, 0.0, rng), 30);
+  std::vector<double> v = z.values;
+  v[0] = 0;
+  EXPECT_FALSE(expect_same_refactorization(z, v, 0));
+}
+
 // Block upper triangular (BTF finds several blocks, singletons among them, and off-diagonal
 // entries), and the same without BTF.
-TEST(KluSolveOne, IsKluSolveBitForBitOnBlockTriangularMatrices) {
+TEST(KluKernels, SolveAndRefactorizationAreKlusOnBlockTriangularMatrices) {
   std::mt19937 rng(11);
   const int n = 60;
   std::vector<double> d = random_sparse(n, 0.08, rng);
@@ -93,11 +153,12 @@ TEST(KluSolveOne, IsKluSolveBitForBitOnBlockTriangularMatrices) {
   const Csc a = to_csc(d, n);
   EXPECT_GE(expect_same_solutions(a, 2, 1, rng), 7);
   EXPECT_EQ(expect_same_solutions(a, 2, 0, rng), 1);
+  for (int btf : {1, 0}) expect_same_refactorization(a, perturbed(a, rng), btf);
 }
 
 // A saddle-point matrix as a multibody Newton matrix has: [M G^T; G 0], zero diagonal in the
 // constraint rows, so partial pivoting leaves the diagonal.
-TEST(KluSolveOne, IsKluSolveBitForBitOnASaddlePointMatrix) {
+TEST(KluKernels, SolveAndRefactorizationAreKlusOnASaddlePointMatrix) {
   std::mt19937 rng(3);
   const int nq = 40, nc = 15, n = nq + nc;
   std::uniform_real_distribution<double> u(-1.0, 1.0), p(0.0, 1.0);
@@ -111,7 +172,10 @@ TEST(KluSolveOne, IsKluSolveBitForBitOnASaddlePointMatrix) {
         d[(nq + r) * n + j] = g;  // G^T
       }
   const Csc a = to_csc(d, n);
-  for (int btf : {1, 0}) expect_same_solutions(a, 2, btf, rng);
+  for (int btf : {1, 0}) {
+    expect_same_solutions(a, 2, btf, rng);
+    expect_same_refactorization(a, perturbed(a, rng), btf);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,168 @@
+#include "core/klu_kernels.h"
+
+namespace mbdae {
+namespace {
+
+// KLU's packed column k of a block's L or U: its row indices (int), then, aligned to a double,
+// its values (KLU's GET_POINTER).
+struct PackedColumn {
+  const int* rows;
+  double* values;
+  int size;
+};
+
+inline PackedColumn column(double* lu, const int* start, const int* length, int k) {
+  double* p = lu + start[k];
+  const int size = length[k];
+  return {reinterpret_cast<const int*>(p), p + (sizeof(int) * size + sizeof(double) - 1) / sizeof(double), size};
+}
+
+// X[rows[p]] -= values[p] * x for a column, four entries at a time (each row appears once in a
+// column, so the order within it does not change any result).
+inline void subtract_column(double* __restrict X, const PackedColumn& c, double x) {
+  const int* __restrict rows = c.rows;
+  const double* __restrict values = c.values;
+  int p = 0;
+  for (; p + 4 <= c.size; p += 4) {
+    const double a0 = values[p] * x, a1 = values[p + 1] * x, a2 = values[p + 2] * x, a3 = values[p + 3] * x;
+    X[rows[p]] -= a0;
+    X[rows[p + 1]] -= a1;
+    X[rows[p + 2]] -= a2;
+    X[rows[p + 3]] -= a3;
+  }
+  for (; p < c.size; ++p) X[rows[p]] -= values[p] * x;
+}
+
+// L U x = x for one diagonal block of size nk (L unit lower, U's diagonal apart).
+void solve_block(const klu_numeric& N, int block, int k1, int nk, double* X) {
+  double* lu = static_cast<double*>(N.LUbx[block]);
+  const double* udiag = static_cast<const double*>(N.Udiag) + k1;
+  for (int k = 0; k < nk; ++k) subtract_column(X, column(lu, N.Lip + k1, N.Llen + k1, k), X[k]);
+  for (int k = nk - 1; k >= 0; --k) {
+    const double x = X[k] / udiag[k];
+    X[k] = x;
+    subtract_column(X, column(lu, N.Uip + k1, N.Ulen + k1, k), x);
+  }
+}
+
+}  // namespace
+
+void klu_solve_one(const klu_symbolic& S, const klu_numeric& N, double* b) {
+  const int n = S.n;
+  double* X = static_cast<double*>(N.Xwork);
+  // X = P (R \ b): the gather, then the divisions in a loop of their own (it vectorizes; IEEE
+  // division rounds each entry alike in either form).
+  for (int k = 0; k < n; ++k) X[k] = b[N.Pnum[k]];
+  if (const double* rs = N.Rs)
+    for (int k = 0; k < n; ++k) X[k] /= rs[k];
+  const double* udiag = static_cast<const double*>(N.Udiag);
+  const double* off = static_cast<const double*>(N.Offx);
+  for (int block = S.nblocks - 1; block >= 0; --block) {
+    const int k1 = S.R[block], k2 = S.R[block + 1];
+    if (k2 - k1 == 1)
+      X[k1] /= udiag[k1];
+    else
+      solve_block(N, block, k1, k2 - k1, X + k1);
+    if (block == 0) break;
+    // The off-diagonal blocks' back substitution.
+    for (int k = k1; k < k2; ++k) {
+      const double x = X[k];
+      for (int p = N.Offp[k]; p < N.Offp[k + 1]; ++p) X[N.Offi[p]] -= off[p] * x;
+    }
+  }
+  for (int k = 0; k < n; ++k) b[S.Q[k]] = X[k];
+}
+
+namespace {
+
+// KLU_scale's row scale: the largest |a| (scale 2 and up) or the sum of |a| (scale 1) of each
+// row, 1 for an empty row; indexed by the original row.
+void row_scale(int n, const int* Ap, const int* Ai, const double* Ax, int scale, double* Rs) {
+  for (int row = 0; row < n; ++row) Rs[row] = 0;
+  for (int col = 0; col < n; ++col)
+    for (int p = Ap[col]; p < Ap[col + 1]; ++p) {
+      const double a = Ax[p] < 0 ? -Ax[p] : Ax[p];
+      double& r = Rs[Ai[p]];
+      if (scale == 1) r += a;
+      else r = r > a ? r : a;
+    }
+  for (int row = 0; row < n; ++row)
+    if (Rs[row] == 0.0) Rs[row] = 1.0;
+}
+
+// Column k of a block: A's column scattered into X (its entries in earlier blocks to Offx), U's
+// column by the left-looking update, L's column divided by the pivot. False at a zero pivot.
+bool factor_column(const int* Ap, const int* Ai, const double* Ax, const klu_symbolic& S, klu_numeric& N,
+                   const double* Rs, int block, int k, double* X, int& poff) {
+  const int k1 = S.R[block];
+  double* lu = static_cast<double*>(N.LUbx[block]);
+  double* Offx = static_cast<double*>(N.Offx);
+  const int oldcol = S.Q[k + k1];
+  for (int p = Ap[oldcol]; p < Ap[oldcol + 1]; ++p) {
+    const int oldrow = Ai[p], newrow = N.Pinv[oldrow] - k1;
+    if (newrow < 0 && poff < S.nzoff) Offx[poff++] = Ax[p] / Rs[oldrow];
+    else X[newrow] = Ax[p] / Rs[oldrow];
+  }
+  const PackedColumn u = column(lu, N.Uip + k1, N.Ulen + k1, k);
+  for (int up = 0; up < u.size; ++up) {
+    const int j = u.rows[up];
+    const double ujk = X[j];
+    X[j] = 0;
+    u.values[up] = ujk;
+    subtract_column(X, column(lu, N.Lip + k1, N.Llen + k1, j), ujk);
+  }
+  const double ukk = X[k];
+  X[k] = 0;
+  if (ukk == 0) return false;
+  static_cast<double*>(N.Udiag)[k + k1] = ukk;
+  const PackedColumn l = column(lu, N.Lip + k1, N.Llen + k1, k);
+  for (int p = 0; p < l.size; ++p) {
+    const int i = l.rows[p];
+    l.values[p] = X[i] / ukk;
+    X[i] = 0;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool klu_refactor_scaled(int* colptr, int* rowind, double* values, klu_symbolic& S, klu_numeric& N,
+                         klu_common& common) {
+  if (common.scale <= 0 || N.Rs == nullptr) return klu_refactor(colptr, rowind, values, &S, &N, &common) != 0;
+  common.status = KLU_OK;
+  common.numerical_rank = -1;
+  common.singular_col = -1;
+  const int n = S.n;
+  double* Rs = N.Rs;
+  double* X = static_cast<double*>(N.Xwork);
+  row_scale(n, colptr, rowind, values, common.scale, Rs);
+  for (int k = 0; k < S.maxblock; ++k) X[k] = 0;
+  int poff = 0;
+  for (int block = 0; block < S.nblocks; ++block) {
+    const int k1 = S.R[block], k2 = S.R[block + 1];
+    if (k2 - k1 == 1) {  // a singleton: its entry, and those in earlier blocks to Offx
+      const int oldcol = S.Q[k1];
+      double s = 0;
+      for (int p = colptr[oldcol]; p < colptr[oldcol + 1]; ++p) {
+        const int oldrow = rowind[p];
+        if (N.Pinv[oldrow] - k1 < 0 && poff < S.nzoff) static_cast<double*>(N.Offx)[poff++] = values[p] / Rs[oldrow];
+        else s = values[p] / Rs[oldrow];
+      }
+      static_cast<double*>(N.Udiag)[k1] = s;
+      continue;
+    }
+    for (int k = 0; k < k2 - k1; ++k)
+      if (!factor_column(colptr, rowind, values, S, N, Rs, block, k, X, poff)) {
+        common.status = KLU_SINGULAR;
+        common.numerical_rank = k + k1;
+        common.singular_col = S.Q[k + k1];
+        return false;
+      }
+  }
+  // The row scale in the pivot order, as klu_solve reads it.
+  for (int k = 0; k < n; ++k) X[k] = Rs[N.Pnum[k]];
+  for (int k = 0; k < n; ++k) Rs[k] = X[k];
+  return true;
+}
+
+}  // namespace mbdae
