@@ -317,7 +317,10 @@ void keep_step(IdaRun& r) {
 void reinit(IdaRun& r, double tt) {
   collect(r.mem, r.stats);
   check(IDAReInit(r.mem, tt, r.y, r.yp), "IDAReInit");
-  if (r.sens_on) check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
+  if (r.sens_on) {
+    check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
+    r.o->sensitivities->reinitialized();
+  }
 }
 
 // A step past t1: the end state and the last samples are interpolated; a root beyond t1 is no

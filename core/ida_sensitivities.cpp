@@ -125,7 +125,8 @@ static bool retry_sensitivities(IdaRun& r) {
   } catch (const SolveError&) {
     return false;
   }
-  r.stats.sensitivity_fallback_time = r.t;
+  if (r.stats.sensitivity_fallback_time < 0) r.stats.sensitivity_fallback_time = r.t;
+  ++r.stats.sensitivity_fallbacks;
   start_again(r);
   return true;
 }

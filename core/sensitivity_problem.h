@@ -29,6 +29,9 @@ class SensitivityProblem {
   // After IDA failed with the sensitivities: switch to a more robust (dearer) residual and return
   // true, the driver then retries from the last accepted step; false if there is none.
   virtual bool fall_back() { return false; }
+  // IDA starts anew (a restart, the re-integration onto an event's root, a retry): its first
+  // steps are tiny.
+  virtual void reinitialized() {}
   // Whether the sensitivities are in the local error test (else only in the Newton test).
   virtual bool in_error_test() const { return false; }
 };

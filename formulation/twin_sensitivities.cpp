@@ -40,6 +40,7 @@ void TwinSensitivities::set_segment(double t_start, double t_end) {
 int TwinSensitivities::residual(double t, const double* y, const double* yp, const double*, const double* const* s,
                                 const double* const* sp, double* const* r) {
   follow(*base_);
+  if (exact_ && after_start_ && ++exact_calls_ > window_) exact_ = false;
   if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
   for (size_t i = 0; i < twins_.size(); ++i) {
     base_->derivative_times(y, sp[i], r[i]);

@@ -51,11 +51,24 @@ class TwinSensitivities : public SensitivityProblem {
   void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
   void set_segment(double t_start, double t_end) override;
   bool in_error_test() const override { return in_error_test_; }
-  // From the twins' central differences to the Newton matrix's A0 (exact, dearer): once.
+  // From the twins' central differences to the Newton matrix's A0 (exact, dearer). The
+  // differences can fail where the steps are tiny, as after IDA starts anew (their rounding,
+  // amplified by 1 / h, above the sensitivities' Newton tolerance): from the first failure on,
+  // A0 serves a window of residuals after every start and after every further failure, twice
+  // as long each time a failure comes after it, and the differences the rest; after
+  // kMaxFailures, A0 to the end. False if A0 failed.
   bool fall_back() override {
-    if (exact_) return false;
+    if (exact_ && (!after_start_ || exact_calls_ <= window_)) return false;
+    if (failures_ > 0) window_ *= 2;
+    after_start_ = ++failures_ < kMaxFailures;
     exact_ = true;
+    exact_calls_ = 0;
     return true;
+  }
+  void reinitialized() override {
+    if (!after_start_) return;
+    exact_ = true;
+    exact_calls_ = 0;
   }
 
   // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' consistent
@@ -79,6 +92,11 @@ class TwinSensitivities : public SensitivityProblem {
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
   bool exact_ = false;  // A0 = F_y assembled (after fall_back), else F_y s + F_p by one difference
+  bool after_start_ = false;  // exact_ only for window_ residuals after a start or a failure
+  int exact_calls_ = 0;  // residuals since then
+  int window_ = 50;
+  int failures_ = 0;
+  static constexpr int kMaxFailures = 10;
   std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
   std::string failure_;

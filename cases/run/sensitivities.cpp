@@ -251,7 +251,10 @@ void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
   stats["sensitivity_nonlinear_iterations"] = st.sensitivity_nonlinear_iterations;
   stats["sensitivity_nonlinear_failures"] = st.sensitivity_nonlinear_failures;
   // Where F_y s went from differences along s to the assembled Newton matrix (formulation/twin_sensitivities.h).
-  if (st.sensitivity_fallback_time >= 0) stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
+  if (st.sensitivity_fallback_time >= 0) {
+    stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
+    stats["sensitivity_fallbacks"] = st.sensitivity_fallbacks;
+  }
   RunSensitivities& rs = *c.sensitivities;
   rs.event_times.insert(rs.event_times.end(), st.event_times.begin(), st.event_times.end());
 }
