@@ -58,7 +58,7 @@ class TwinSensitivities : public SensitivityProblem {
   // as long each time a failure comes after it, and the differences the rest; after
   // kMaxFailures, A0 to the end. False if A0 failed.
   bool fall_back() override {
-    if (exact_ && (!after_start_ || exact_calls_ <= window_)) return false;
+    if (exact_) return false;
     if (failures_ > 0) window_ *= 2;
     after_start_ = ++failures_ < kMaxFailures;
     exact_ = true;
