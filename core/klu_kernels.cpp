@@ -1,5 +1,7 @@
 #include "core/klu_kernels.h"
 
+#include <cmath>
+
 namespace mbdae {
 namespace {
 
@@ -81,7 +83,7 @@ void row_scale(int n, const int* Ap, const int* Ai, const double* Ax, int scale,
   for (int row = 0; row < n; ++row) Rs[row] = 0;
   for (int col = 0; col < n; ++col)
     for (int p = Ap[col]; p < Ap[col + 1]; ++p) {
-      const double a = Ax[p] < 0 ? -Ax[p] : Ax[p];
+      const double a = std::fabs(Ax[p]);
       double& r = Rs[Ai[p]];
       if (scale == 1) r += a;
       else r = r > a ? r : a;

@@ -15,7 +15,8 @@
 // step's restart), fall_back() turns to A0 s, A0 = F_y the formulation's own Newton matrix at
 // cj = 0 (exact, one assembly per call for all parameters, on a copy of the run's DAE), plus F_p
 // as the twins' difference at the same (y, y') (the terms that do not depend on p are evaluated
-// bit for bit alike in both twins and cancel), and the driver retries from the last step.
+// bit for bit alike in both twins and cancel), and the driver retries from the last step; from
+// then on A0 serves the first residuals after every start of IDA (fall_back, below).
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 #pragma once
