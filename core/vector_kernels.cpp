@@ -122,6 +122,12 @@ static void sundials_sequence(int nvec, double* c, N_Vector* X, N_Vector z) {
   for (int i = 1; i < nvec; ++i) linear_sum(c[i], X[i], 1.0, z, z);
 }
 
+// The same over the i-th vectors of the arrays X[0..nvec) (a vector array's combination).
+static void sundials_sequence_of(int nvec, double* c, N_Vector** X, int i, N_Vector z) {
+  scale(c[0], X[0][i], z);
+  for (int j = 1; j < nvec; ++j) linear_sum(c[j], X[j][i], 1.0, z, z);
+}
+
 // z = sum_i c[i] X[i] for N vectors known at compile time: the sum over i unrolled, so that the
 // loop over the elements is a plain (vectorizable) one. Per element the same products and sums,
 // in the same order, as sundials_sequence (c * x is exact for c = +-1, where SUNDIALS copies,
@@ -160,9 +166,28 @@ int fused_linear_combination(int nvec, double* c, N_Vector* X, N_Vector z) {
   }
 }
 
+// Z[i] = sum_j c[j] X[j][i] for each i (IDAS's sensitivities: the predictor and the
+// interpolation of every sensitivity vector): the fused combination per vector, as SUNDIALS'
+// N_VLinearCombinationVectorArray does with it, without that function's malloc and free of its
+// array of vectors at every call.
+int linear_combination_vector_array(int nvec, int nsum, double* c, N_Vector** X, N_Vector* Z) {
+  constexpr int kTerms = 16;  // IDAS passes at most its history's 6
+  N_Vector Y[kTerms];
+  for (int i = 0; i < nvec; ++i) {
+    if (nsum > kTerms) {
+      sundials_sequence_of(nsum, c, X, i, Z[i]);
+      continue;
+    }
+    for (int j = 0; j < nsum; ++j) Y[j] = X[j][i];
+    if (const int flag = fused_linear_combination(nsum, c, Y, Z[i]); flag != 0) return flag;
+  }
+  return 0;
+}
+
 void use_vector_kernels(N_Vector v) {
   N_Vector_Ops o = v->ops;
   o->nvlinearcombination = fused_linear_combination;
+  o->nvlinearcombinationvectorarray = linear_combination_vector_array;
   o->nvlinearsum = linear_sum;
   o->nvscale = scale;
   o->nvconst = constant;

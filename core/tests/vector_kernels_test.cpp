@@ -1,6 +1,6 @@
 // mbdae's vector kernels (core/vector_kernels.h) against SUNDIALS' own serial operations, bit for
 // bit: the fused linear combination for 1 to 7 vectors, coefficients +-1 among them, z aliasing an
-// input; the linear sum for every special case of SUNDIALS' (coefficients 1, -1, equal, opposite,
+// input, and over arrays of vectors (IDAS's sensitivities); the linear sum for every special case of SUNDIALS' (coefficients 1, -1, equal, opposite,
 // z aliasing x or y), scale, constant and the weighted norms.
 #include "core/vector_kernels.h"
 
@@ -58,6 +58,33 @@ TEST(VectorKernels, LinearCombinationIsSundialsSequenceBitForBit) {
     fused_linear_combination(nvec, c.data(), in.v.data(), fused);
     reference(nvec, c.data(), in.v.data(), ref);
     EXPECT_TRUE(same_bits(fused, ref)) << nvec << " vectors";
+  }
+}
+
+// IDAS's vector-array combination (its sensitivities): per vector as SUNDIALS' own generic
+// N_VLinearCombinationVectorArray on vectors without any fused operation, for histories of 1 to
+// 6 vectors and for more terms than the kernel's array holds (20).
+TEST(VectorKernels, VectorArrayCombinationIsSundialsBitForBit) {
+  const int n = 157, nvec = 3;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int nsum : {1, 2, 3, 6, 20}) {
+    Vectors in(nsum * nvec + 2 * nvec, n);
+    std::vector<std::vector<N_Vector>> X(nsum);
+    std::vector<N_Vector*> Xp(nsum);
+    for (int j = 0; j < nsum; ++j) {
+      for (int i = 0; i < nvec; ++i) X[j].push_back(in.v[j * nvec + i]);
+      Xp[j] = X[j].data();
+    }
+    std::vector<N_Vector> ours(in.v.begin() + nsum * nvec, in.v.begin() + nsum * nvec + nvec);
+    std::vector<N_Vector> theirs(in.v.begin() + nsum * nvec + nvec, in.v.end());
+    std::vector<double> c(nsum);
+    for (int j = 0; j < nsum; ++j) c[j] = j == 1 ? -1.0 : u(rng);
+    ASSERT_EQ(theirs[0]->ops->nvlinearcombinationvectorarray, nullptr);
+    ASSERT_EQ(theirs[0]->ops->nvlinearcombination, nullptr);
+    N_VLinearCombinationVectorArray(nvec, nsum, c.data(), Xp.data(), theirs.data());
+    EXPECT_EQ(linear_combination_vector_array(nvec, nsum, c.data(), Xp.data(), ours.data()), 0);
+    for (int i = 0; i < nvec; ++i) EXPECT_TRUE(same_bits(ours[i], theirs[i])) << nsum << " terms, vector " << i;
   }
 }
 
@@ -134,6 +161,7 @@ TEST(VectorKernels, ClonesInheritTheOperation) {
   use_vector_kernels(in.v[0]);
   N_Vector clone = N_VClone(in.v[0]);
   EXPECT_EQ(clone->ops->nvlinearcombination, &fused_linear_combination);
+  EXPECT_EQ(clone->ops->nvlinearcombinationvectorarray, &linear_combination_vector_array);
   EXPECT_EQ(clone->ops->nvlinearsum, in.v[0]->ops->nvlinearsum);
   EXPECT_NE(clone->ops->nvlinearsum, &N_VLinearSum_Serial);
   N_VDestroy(clone);
