@@ -1,7 +1,8 @@
 // No heap allocation inside the step loop: residual, Newton matrix, KLU refactorization, output
-// sampling and IDAS's sensitivities. Every malloc, calloc and realloc of the process is counted (C++ new goes through
-// malloc), including those of KLU and SUNDIALS; the dynamics I run is observed between two output
-// samples of a phase without events (the restart at an event does allocate, by design).
+// sampling and IDAS's sensitivities. Every malloc, calloc and realloc of the process is counted
+// (C++ new goes through malloc), including those of KLU and SUNDIALS; the dynamics I run is
+// observed between two output samples of a phase without events (the restart at an event does
+// allocate, by design).
 #include <gtest/gtest.h>
 
 #include <atomic>
