@@ -55,8 +55,8 @@ class TwinSensitivities : public SensitivityProblem {
   // From the twins' central differences to the Newton matrix's A0 (exact, dearer). The
   // differences can fail where the steps are tiny, as after IDA starts anew (their rounding,
   // amplified by 1 / h, above the sensitivities' Newton tolerance): from the first failure on,
-  // A0 serves a window of residuals after every start and after every further failure, twice
-  // as long each time a failure comes after it, and the differences the rest; after
+  // A0 serves a window of residuals after every start of IDA (a failure's retry is one), the
+  // window twice as long after each further failure, and the differences the rest; after
   // kMaxFailures, A0 to the end. False if A0 failed.
   bool fall_back() override {
     if (exact_) return false;

@@ -250,7 +250,8 @@ void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
   stats["sensitivity_residual_evaluations"] = st.sensitivity_residual_evals;
   stats["sensitivity_nonlinear_iterations"] = st.sensitivity_nonlinear_iterations;
   stats["sensitivity_nonlinear_failures"] = st.sensitivity_nonlinear_failures;
-  // Where F_y s went from differences along s to the assembled Newton matrix (formulation/twin_sensitivities.h).
+  // Where the differences first failed and the assembled Newton matrix took over, and how many
+  // retries that took (formulation/twin_sensitivities.h).
   if (st.sensitivity_fallback_time >= 0) {
     stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
     stats["sensitivity_fallbacks"] = st.sensitivity_fallbacks;
