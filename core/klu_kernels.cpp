@@ -130,7 +130,8 @@ bool factor_column(const int* Ap, const int* Ai, const double* Ax, const klu_sym
 
 bool klu_refactor_scaled(int* colptr, int* rowind, double* values, klu_symbolic& S, klu_numeric& N,
                          klu_common& common) {
-  if (common.scale <= 0 || N.Rs == nullptr) return klu_refactor(colptr, rowind, values, &S, &N, &common) != 0;
+  if (common.scale <= 0 || N.Rs == nullptr || !common.halt_if_singular)
+    return klu_refactor(colptr, rowind, values, &S, &N, &common) != 0;
   common.status = KLU_OK;
   common.numerical_rank = -1;
   common.singular_col = -1;

@@ -15,8 +15,8 @@ namespace mbdae {
 void klu_solve_one(const klu_symbolic& symbolic, const klu_numeric& numeric, double* b);
 
 // klu_refactor of A (colptr, rowind, values: the analyzed pattern) into numeric, for common.scale
-// > 0 and numeric's row scale present (else it calls klu_refactor). False, as klu_refactor with
-// halt_if_singular, at an exactly zero pivot (common.status KLU_SINGULAR).
+// > 0, numeric's row scale present and common.halt_if_singular (KLU's defaults; else it calls
+// klu_refactor). False, as klu_refactor, at an exactly zero pivot (common.status KLU_SINGULAR).
 bool klu_refactor_scaled(int* colptr, int* rowind, double* values, klu_symbolic& symbolic, klu_numeric& numeric,
                          klu_common& common);
 
