@@ -1,6 +1,7 @@
 #include "formulation/constraints.h"
 
 #include <cmath>
+#include <type_traits>
 
 namespace mbdae {
 namespace {
@@ -24,18 +25,27 @@ Row14 dot1_gradient(int bi, int bj, const LocalState& s, const Vec3& a, const Ve
   return g;
 }
 
+// The jets below are templates over J: ScalarJet (value, gradient and Hessian) or ScalarSlope
+// (value and gradient only, for the turns and the sensors, which read no Hessian). Value and
+// gradient are the same expressions in both, so the same bits.
+template <class J>
+constexpr bool kHessian = std::is_same_v<J, ScalarJet>;
+
 // Value, gradient and Hessian of (A_i a).(A_j b): a dot product of two body-fixed vectors.
-ScalarJet dot1_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& b) {
-  ScalarJet j;
+template <class J>
+J dot1_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& b) {
+  J j;
   const Vec3 u = world_vector(bi, s.pi, a), w = world_vector(bj, s.pj, b);
   j.value = u.dot(w);
   j.grad = dot1_gradient(bi, bj, s, a, b);
-  if (bi >= 0) j.hess.block<4, 4>(kPi4, kPi4) = K_matrix(a, w);
-  if (bj >= 0) j.hess.block<4, 4>(kPj, kPj) = K_matrix(b, u);
-  if (bi >= 0 && bj >= 0) {
-    const Mat34 bu = B_matrix(s.pi, a), bw = B_matrix(s.pj, b);
-    j.hess.block<4, 4>(kPi4, kPj) = bu.transpose() * bw;
-    j.hess.block<4, 4>(kPj, kPi4) = bw.transpose() * bu;
+  if constexpr (kHessian<J>) {
+    if (bi >= 0) j.hess.template block<4, 4>(kPi4, kPi4) = K_matrix(a, w);
+    if (bj >= 0) j.hess.template block<4, 4>(kPj, kPj) = K_matrix(b, u);
+    if (bi >= 0 && bj >= 0) {
+      const Mat34 bu = B_matrix(s.pi, a), bw = B_matrix(s.pj, b);
+      j.hess.template block<4, 4>(kPi4, kPj) = bu.transpose() * bw;
+      j.hess.template block<4, 4>(kPj, kPi4) = bw.transpose() * bu;
+    }
   }
   return j;
 }
@@ -57,64 +67,74 @@ Row14 dot2_gradient(int bi, int bj, const LocalState& s, const Vec3& a, const Ve
 }
 
 // Its value, gradient and Hessian.
-ScalarJet dot2_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& si,
-                   const Vec3& sj) {
-  ScalarJet j;
+template <class J>
+J dot2_jet(int bi, int bj, const LocalState& s, const Vec3& a, const Vec3& si, const Vec3& sj) {
+  J j;
   const Vec3 u = world_vector(bi, s.pi, a);
   const Vec3 d = world_point(bj, s.rj, s.pj, sj) - world_point(bi, s.ri, s.pi, si);
   j.value = u.dot(d);
   j.grad = dot2_gradient(bi, bj, s, a, si, sj);
-  Mat34 ba = Mat34::Zero();
-  if (bi >= 0) {
-    ba = B_matrix(s.pi, a);
-    const Mat34 bs = B_matrix(s.pi, si);
-    j.hess.block<3, 4>(kRi, kPi4) = -ba;
-    j.hess.block<4, 3>(kPi4, kRi) = -ba.transpose();
-    j.hess.block<4, 4>(kPi4, kPi4) =
-        K_matrix(a, d) - K_matrix(si, u) - ba.transpose() * bs - bs.transpose() * ba;
-  }
-  if (bj >= 0) {
-    const Mat34 bsj = B_matrix(s.pj, sj);
-    j.hess.block<4, 4>(kPj, kPj) = K_matrix(sj, u);
+  if constexpr (kHessian<J>) {
+    Mat34 ba = Mat34::Zero();
     if (bi >= 0) {
-      j.hess.block<4, 3>(kPi4, kRj) = ba.transpose();
-      j.hess.block<3, 4>(kRj, kPi4) = ba;
-      j.hess.block<4, 4>(kPi4, kPj) = ba.transpose() * bsj;
-      j.hess.block<4, 4>(kPj, kPi4) = bsj.transpose() * ba;
+      ba = B_matrix(s.pi, a);
+      const Mat34 bs = B_matrix(s.pi, si);
+      j.hess.template block<3, 4>(kRi, kPi4) = -ba;
+      j.hess.template block<4, 3>(kPi4, kRi) = -ba.transpose();
+      j.hess.template block<4, 4>(kPi4, kPi4) =
+          K_matrix(a, d) - K_matrix(si, u) - ba.transpose() * bs - bs.transpose() * ba;
+    }
+    if (bj >= 0) {
+      const Mat34 bsj = B_matrix(s.pj, sj);
+      j.hess.template block<4, 4>(kPj, kPj) = K_matrix(sj, u);
+      if (bi >= 0) {
+        j.hess.template block<4, 3>(kPi4, kRj) = ba.transpose();
+        j.hess.template block<3, 4>(kRj, kPi4) = ba;
+        j.hess.template block<4, 4>(kPi4, kPj) = ba.transpose() * bsj;
+        j.hess.template block<4, 4>(kPj, kPi4) = bsj.transpose() * ba;
+      }
     }
   }
   return j;
 }
 
 // theta = atan2(y, x) from the jets of y and x.
-ScalarJet atan2_jet(const ScalarJet& y, const ScalarJet& x) {
-  ScalarJet j;
+template <class J>
+J atan2_jet(const J& y, const J& x) {
+  J j;
   const double r2 = x.value * x.value + y.value * y.value;
   j.value = std::atan2(y.value, x.value);
   const double tx = -y.value / r2, ty = x.value / r2;
-  const double txx = 2 * x.value * y.value / (r2 * r2), tyy = -txx;
-  const double txy = (y.value * y.value - x.value * x.value) / (r2 * r2);
   j.grad = tx * x.grad + ty * y.grad;
-  j.hess = tx * x.hess + ty * y.hess + txx * x.grad.transpose() * x.grad +
-           tyy * y.grad.transpose() * y.grad +
-           txy * (x.grad.transpose() * y.grad + y.grad.transpose() * x.grad);
+  if constexpr (kHessian<J>) {
+    const double txx = 2 * x.value * y.value / (r2 * r2), tyy = -txx;
+    const double txy = (y.value * y.value - x.value * x.value) / (r2 * r2);
+    j.hess = tx * x.hess + ty * y.hess + txx * x.grad.transpose() * x.grad +
+             tyy * y.grad.transpose() * y.grad +
+             txy * (x.grad.transpose() * y.grad + y.grad.transpose() * x.grad);
+  }
   return j;
 }
 
-ScalarJet asin_jet(const ScalarJet& z) {
-  ScalarJet j;
+template <class J>
+J asin_jet(const J& z) {
+  J j;
   const double c2 = 1.0 - z.value * z.value;
   j.value = std::asin(z.value);
-  const double d1 = 1.0 / std::sqrt(c2), d2 = z.value / (c2 * std::sqrt(c2));
+  const double d1 = 1.0 / std::sqrt(c2);
   j.grad = d1 * z.grad;
-  j.hess = d1 * z.hess + d2 * z.grad.transpose() * z.grad;
+  if constexpr (kHessian<J>) {
+    const double d2 = z.value / (c2 * std::sqrt(c2));
+    j.hess = d1 * z.hess + d2 * z.grad.transpose() * z.grad;
+  }
   return j;
 }
 
-ScalarJet scaled(ScalarJet j, double f) {
+template <class J>
+J scaled(J j, double f) {
   j.value *= f;
   j.grad *= f;
-  j.hess *= f;
+  if constexpr (kHessian<J>) j.hess *= f;
   return j;
 }
 
@@ -140,32 +160,37 @@ double wrap_angle(double a) {
   return a - kPi;
 }
 
-ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s) {
+namespace {
+
+// A coordinate function's jet (J = ScalarJet) or slope (J = ScalarSlope).
+template <class J>
+J coordinate_function(const CoordinateFunction& f, const LocalState& s) {
   const int bp = f.body_parent, bc = f.body_child;
   if (!f.rotation) {
     // Offset of the child origin from the anchor along a frame axis.
     if (!f.child_frame)
-      return dot2_jet(bp, bc, s, f.frame_parent.col(f.axis), f.anchor, f.origin);
+      return dot2_jet<J>(bp, bc, s, f.frame_parent.col(f.axis), f.anchor, f.origin);
     // Axis fixed in the child: swap the roles (body i = child) and flip the sign.
     LocalState sw;
     sw.ri = s.rj;
     sw.pi = s.pj;
     sw.rj = s.ri;
     sw.pj = s.pi;
-    ScalarJet j = dot2_jet(bc, bp, sw, f.frame_child.col(f.axis), f.origin, f.anchor);
-    ScalarJet out = scaled(j, -1.0);
+    J j = dot2_jet<J>(bc, bp, sw, f.frame_child.col(f.axis), f.origin, f.anchor);
+    J out = scaled(j, -1.0);
     // Swap the local blocks back.
     Eigen::Matrix<int, 14, 1> perm;
     for (int k = 0; k < 14; ++k) perm[k] = (k + 7) % 14;
     for (int a = 0; a < 14; ++a) {
       out.grad(perm[a]) = -j.grad(a);
-      for (int b = 0; b < 14; ++b) out.hess(perm[a], perm[b]) = -j.hess(a, b);
+      if constexpr (kHessian<J>)
+        for (int b = 0; b < 14; ++b) out.hess(perm[a], perm[b]) = -j.hess(a, b);
     }
     return out;
   }
   // Relative rotation entries R[m][n] = (A_p fp_m).(A_c fc_n).
   auto entry = [&](int m, int n) {
-    return dot1_jet(bp, bc, s, f.frame_parent.col(m), f.frame_child.col(n));
+    return dot1_jet<J>(bp, bc, s, f.frame_parent.col(m), f.frame_child.col(n));
   };
   const int i0 = f.ax[0], i1 = f.ax[1], i2 = f.ax[2];
   const double sg = parity(i0, i1, i2);
@@ -174,6 +199,16 @@ ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s) {
     case 1: return asin_jet(scaled(entry(i0, i2), sg));
     default: return atan2_jet(scaled(entry(i0, i1), -sg), entry(i0, i0));
   }
+}
+
+}  // namespace
+
+ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s) {
+  return coordinate_function<ScalarJet>(f, s);
+}
+
+ScalarSlope coordinate_slope(const CoordinateFunction& f, const LocalState& s) {
+  return coordinate_function<ScalarSlope>(f, s);
 }
 
 // --- The primitives -----------------------------------------------------------------------
@@ -246,7 +281,7 @@ void dot1_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
   rows[0] = dot1_gradient(c.bi, c.bj, s, c.ai, c.aj);
 }
 void dot1_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
-  h += w[0] * dot1_jet(c.bi, c.bj, s, c.ai, c.aj).hess;
+  h += w[0] * dot1_jet<ScalarJet>(c.bi, c.bj, s, c.ai, c.aj).hess;
 }
 void dot1_velocity(const Constraint& c, const LocalState& s, const LocalState& v, double* g) {
   const Vec3 u = world_vector(c.bi, s.pi, c.ai), w = world_vector(c.bj, s.pj, c.aj);
@@ -264,7 +299,7 @@ void dot2_jacobian(const Constraint& c, const LocalState& s, Row14* rows) {
   rows[0] = dot2_gradient(c.bi, c.bj, s, c.ai, c.si, c.sj);
 }
 void dot2_hessian(const Constraint& c, const LocalState& s, const double* w, Mat14& h) {
-  h += w[0] * dot2_jet(c.bi, c.bj, s, c.ai, c.si, c.sj).hess;
+  h += w[0] * dot2_jet<ScalarJet>(c.bi, c.bj, s, c.ai, c.si, c.sj).hess;
 }
 
 // kDistance: |d|^2 - D^2, d = r_j + A_j s_j - r_i - A_i s_i.

@@ -105,6 +105,13 @@ struct ScalarJet {
   Mat14 hess = Mat14::Zero();
 };
 ScalarJet coordinate_jet(const CoordinateFunction& f, const LocalState& s);
+// Its value and gradient alone, bit for bit coordinate_jet's, without the Hessian's cost (the
+// turns at every step, the coordinate sensors).
+struct ScalarSlope {
+  double value = 0;
+  Row14 grad = Row14::Zero();
+};
+ScalarSlope coordinate_slope(const CoordinateFunction& f, const LocalState& s);
 
 // The three kOrientation rows w_k (k = x, y, z) that hold conj(p_i) (x) p_j = d, i.e. the
 // frames with Euler parameters c_i on body i and c_j on body j aligned, d = c_i (x) conj(c_j).

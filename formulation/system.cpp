@@ -64,14 +64,14 @@ double coordinate_value(const System& sys, int k, const double* q) {
   const JointCoordinate& jc = sys.coordinates[k];
   if (jc.merged) return jc.value_if_merged;
   const LocalState s = gather(q, jc.function.body_parent, jc.function.body_child);
-  return coordinate_jet(jc.function, s).value;
+  return coordinate_slope(jc.function, s).value;
 }
 
 double coordinate_rate(const System& sys, int k, const double* q, const double* v) {
   const JointCoordinate& jc = sys.coordinates[k];
   if (jc.merged) return 0.0;
   const LocalState s = gather(q, jc.function.body_parent, jc.function.body_child);
-  return coordinate_jet(jc.function, s).grad.dot(
+  return coordinate_slope(jc.function, s).grad.dot(
       gather_local(v, jc.function.body_parent, jc.function.body_child));
 }
 
@@ -116,10 +116,10 @@ std::vector<int> coordinates_with_turns(const System& sys) {
 // and a mechanism has one per joint angle (docs/performance.md).
 void update_turns(const System& sys, const double* q, const double* v, double t, CoordinateTurns& turns) {
   for (const int k : sys.turn_coordinates) {
-    // One jet for the value and the rate (coordinate_value and coordinate_rate would evaluate it
-    // twice: a sixth of a plain index2-ggl step on Dynamics I, docs/performance.md).
+    // One slope (value and gradient, coordinate_jet's without its Hessian) for the value and the
+    // rate: coordinate_value and coordinate_rate would evaluate it twice.
     const CoordinateFunction& f = sys.coordinates[k].function;
-    const ScalarJet jet = coordinate_jet(f, gather(q, f.body_parent, f.body_child));
+    const ScalarSlope jet = coordinate_slope(f, gather(q, f.body_parent, f.body_child));
     const double value = continuous_coordinate(sys, k, jet.value, t, &turns);
     const double rate = jet.grad.dot(gather_local(v, f.body_parent, f.body_child));
     if (!std::isfinite(value) || !std::isfinite(rate)) continue;  // the run stops on it elsewhere

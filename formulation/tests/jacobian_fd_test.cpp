@@ -2,8 +2,10 @@
 // Hessians, applied-force Jacobians, and the full index-3 Newton matrix dF/dy + cj dF/dy'.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 
+#include "formulation/constraints.h"
 #include "formulation/forces.h"
 #include "formulation/index3_dae.h"
 #include "formulation/mechanics.h"
@@ -74,6 +76,30 @@ TEST(JacobianFd, ConstraintGradientsAndHessians) {
     checked[static_cast<int>(c.type)]++;
   }
   for (int t = 0; t < kTypes; ++t) EXPECT_GT(checked[t], 0) << "constraint type " << t << " not exercised";
+}
+
+// coordinate_slope is coordinate_jet without the Hessian: the same value and gradient, bit for
+// bit, for every joint coordinate of the model (rotations about each axis, translations) at
+// several states.
+TEST(JacobianFd, CoordinateSlopeIsTheJetsValueAndGradient) {
+  const System sys = build_system(all_types_model());
+  int checked = 0, rotations = 0;
+  for (int seed = 1; seed <= 4; ++seed) {
+    const RandomState st = random_state(sys, seed);
+    for (const JointCoordinate& jc : sys.coordinates) {
+      if (jc.merged) continue;
+      const LocalState s = gather(st.q.data(), jc.function.body_parent, jc.function.body_child);
+      const ScalarJet jet = coordinate_jet(jc.function, s);
+      const ScalarSlope slope = coordinate_slope(jc.function, s);
+      EXPECT_EQ(std::memcmp(&jet.value, &slope.value, sizeof(double)), 0) << jc.name;
+      EXPECT_EQ(std::memcmp(jet.grad.data(), slope.grad.data(), 14 * sizeof(double)), 0) << jc.name;
+      ++checked;
+      rotations += jc.function.rotation ? 1 : 0;
+    }
+  }
+  EXPECT_GT(checked, 8);
+  EXPECT_GT(rotations, 0);
+  EXPECT_LT(rotations, checked);
 }
 
 // gamma = -d2Phi/dt2 along q(t) = q + v t (q'' = 0), by a central second difference in time.
