@@ -10,7 +10,7 @@
 #include <new>
 
 #include "core/ida_driver.h"
-#include "core/sensitivity_problem.h"
+#include "core/tests/decay_problem.h"
 #include "formulation/index3_dae.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
@@ -96,52 +96,11 @@ void expect_none_in_the_step_loop(bool reduced_newton) {
   EXPECT_GT(g_allocations.load(), 100);
 }
 
-// A decay y0' = -y0 with an algebraic y1 = 2 y0, and its sensitivity to the initial value:
-// the step loop of IDAS with sensitivities (their vector arrays, their residual and solves).
-class Decay : public DaeProblem {
- public:
-  Decay() {
-    pattern_.rows = pattern_.cols = 2;
-    pattern_.colptr = {0, 2, 3};
-    pattern_.rowind = {0, 1, 1};
-  }
-  int size() const override { return 2; }
-  const CscPattern& jacobian_pattern() override { return pattern_; }
-  int residual(double, const double* y, const double* yp, double* r) override {
-    r[0] = yp[0] + y[0];
-    r[1] = y[1] - 2 * y[0];
-    return 0;
-  }
-  int jacobian(double, double cj, const double*, const double*, double* v) override {
-    v[0] = 1 + cj, v[1] = -2, v[2] = 1;
-    return 0;
-  }
-  void error_test_mask(double* id) const override { id[0] = 1, id[1] = 0; }
-
- private:
-  CscPattern pattern_;
-};
-
-class DecayInitialValue : public SensitivityProblem {
- public:
-  int count() const override { return 1; }
-  double scale(int) const override { return 1.0; }
-  int residual(double, const double*, const double*, const double*, const double* const* s, const double* const* sp,
-               double* const* r) override {
-    r[0][0] = sp[0][0] + s[0][0];
-    r[0][1] = s[0][1] - 2 * s[0][0];
-    return 0;
-  }
-  void initial(double, const double*, const double*, double* const* s, double* const* sp) override {
-    s[0][0] = 1, s[0][1] = 2, sp[0][0] = -1, sp[0][1] = -2;
-  }
-  void restart(double, const double*, const double*, double* const*, double* const*) override {}
-  bool in_error_test() const override { return true; }
-};
-
+// The step loop of IDAS with sensitivities (their vector arrays, their residual and solves), on
+// the decay of core/tests/decay_problem.h and its sensitivity to the initial value.
 TEST(Allocations, NoneInTheStepLoopWithSensitivities) {
-  Decay p;
-  DecayInitialValue sens;
+  testing::DecayProblem p;
+  testing::DecayInitialValue sens;
   std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
   IdaOptions o;
   o.t1 = 20;
