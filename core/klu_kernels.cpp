@@ -92,12 +92,10 @@ void row_scale(int n, const int* Ap, const int* Ai, const double* Ax, int scale,
     if (Rs[row] == 0.0) Rs[row] = 1.0;
 }
 
-// Column k of a block: A's column scattered into X (its entries in earlier blocks to Offx), U's
-// column by the left-looking update, L's column divided by the pivot. False at a zero pivot.
-bool factor_column(const int* Ap, const int* Ai, const double* Ax, const klu_symbolic& S, klu_numeric& N,
-                   const double* Rs, int block, int k, double* X, int& poff) {
-  const int k1 = S.R[block];
-  double* lu = static_cast<double*>(N.LUbx[block]);
+// A's column of pivot k (the block from k1), divided by the row scale: its entries in the block
+// into X (rows counted from k1), those in earlier blocks to Offx, in KLU's order.
+void scatter_column(const int* Ap, const int* Ai, const double* Ax, const klu_symbolic& S, klu_numeric& N,
+                    const double* Rs, int k1, int k, double* X, int& poff) {
   double* Offx = static_cast<double*>(N.Offx);
   const int oldcol = S.Q[k + k1];
   for (int p = Ap[oldcol]; p < Ap[oldcol + 1]; ++p) {
@@ -105,6 +103,15 @@ bool factor_column(const int* Ap, const int* Ai, const double* Ax, const klu_sym
     if (newrow < 0 && poff < S.nzoff) Offx[poff++] = Ax[p] / Rs[oldrow];
     else X[newrow] = Ax[p] / Rs[oldrow];
   }
+}
+
+// Column k of a block: A's column scattered into X, U's column by the left-looking update, L's
+// column divided by the pivot. False at a zero pivot.
+bool factor_column(const int* Ap, const int* Ai, const double* Ax, const klu_symbolic& S, klu_numeric& N,
+                   const double* Rs, int block, int k, double* X, int& poff) {
+  const int k1 = S.R[block];
+  double* lu = static_cast<double*>(N.LUbx[block]);
+  scatter_column(Ap, Ai, Ax, S, N, Rs, k1, k, X, poff);
   const PackedColumn u = column(lu, N.Uip + k1, N.Ulen + k1, k);
   for (int up = 0; up < u.size; ++up) {
     const int j = u.rows[up];
@@ -143,15 +150,10 @@ bool klu_refactor_scaled(int* colptr, int* rowind, double* values, klu_symbolic&
   int poff = 0;
   for (int block = 0; block < S.nblocks; ++block) {
     const int k1 = S.R[block], k2 = S.R[block + 1];
-    if (k2 - k1 == 1) {  // a singleton: its entry, and those in earlier blocks to Offx
-      const int oldcol = S.Q[k1];
-      double s = 0;
-      for (int p = colptr[oldcol]; p < colptr[oldcol + 1]; ++p) {
-        const int oldrow = rowind[p];
-        if (N.Pinv[oldrow] - k1 < 0 && poff < S.nzoff) static_cast<double*>(N.Offx)[poff++] = values[p] / Rs[oldrow];
-        else s = values[p] / Rs[oldrow];
-      }
-      static_cast<double*>(N.Udiag)[k1] = s;
+    if (k2 - k1 == 1) {  // a singleton: its entry is U's diagonal
+      scatter_column(colptr, rowind, values, S, N, Rs, k1, 0, X, poff);
+      static_cast<double*>(N.Udiag)[k1] = X[0];
+      X[0] = 0;
       continue;
     }
     for (int k = 0; k < k2 - k1; ++k)

@@ -114,18 +114,13 @@ double wrms_norm_mask(N_Vector x, N_Vector w, N_Vector id) {
 
 }  // namespace
 
-// SUNDIALS' sequence without a fused operation: z = c0 X0 (N_VScale), then z += c_i X_i
-// (N_VLinearSum with b = 1 and y = z: axpy). Kept for the aliasing it allows (z one of X[1..])
-// and for more than 7 vectors (IDA passes at most 6).
-static void sundials_sequence(int nvec, double* c, N_Vector* X, N_Vector z) {
-  scale(c[0], X[0], z);
-  for (int i = 1; i < nvec; ++i) linear_sum(c[i], X[i], 1.0, z, z);
-}
-
-// The same over the i-th vectors of the arrays X[0..nvec) (a vector array's combination).
-static void sundials_sequence_of(int nvec, double* c, N_Vector** X, int i, N_Vector z) {
-  scale(c[0], X[0][i], z);
-  for (int j = 1; j < nvec; ++j) linear_sum(c[j], X[j][i], 1.0, z, z);
+// SUNDIALS' sequence without a fused operation: z = c0 X(0) (N_VScale), then z += c_i X(i)
+// (N_VLinearSum with b = 1 and y = z: axpy), X(i) the i-th vector. Kept for the aliasing it
+// allows (z one of X[1..]) and for more than 7 vectors (IDA passes at most 6).
+template <class Vectors>
+static void sundials_sequence(int nvec, const double* c, Vectors X, N_Vector z) {
+  scale(c[0], X(0), z);
+  for (int i = 1; i < nvec; ++i) linear_sum(c[i], X(i), 1.0, z, z);
 }
 
 // z = sum_i c[i] X[i] for N vectors known at compile time: the sum over i unrolled, so that the
@@ -152,7 +147,7 @@ int fused_linear_combination(int nvec, double* c, N_Vector* X, N_Vector z) {
   bool aliased = false;
   for (int i = 1; i < nvec; ++i) aliased = aliased || X[i] == z;
   if (aliased || nvec > 7) {
-    sundials_sequence(nvec, c, X, z);
+    sundials_sequence(nvec, c, [X](int i) { return X[i]; }, z);
     return 0;
   }
   switch (nvec) {
@@ -175,7 +170,7 @@ int linear_combination_vector_array(int nvec, int nsum, double* c, N_Vector** X,
   N_Vector Y[kTerms];
   for (int i = 0; i < nvec; ++i) {
     if (nsum > kTerms) {
-      sundials_sequence_of(nsum, c, X, i, Z[i]);
+      sundials_sequence(nsum, c, [X, i](int j) { return X[j][i]; }, Z[i]);
       continue;
     }
     for (int j = 0; j < nsum; ++j) Y[j] = X[j][i];

@@ -52,9 +52,7 @@ void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* 
   // Tolerances of q times (h/T)^2, never below the rounding of the coordinates (1e3 eps of the
   // model's positions, 1e3 eps for Euler parameters), never looser than the plain test.
   const double r = abs_tol_.time / h, f = max_num(1.0, r * r);
-  double rmax = abs_tol_.length;
-  for (int i = 0; i < nq_; i += 7) rmax = max_num(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
-  const double w_length = 1.0 / (kRoundingFloor * rmax), w_rotation = 1.0 / kRoundingFloor;
+  const double w_length = 1.0 / (kRoundingFloor * position_magnitude(y)), w_rotation = 1.0 / kRoundingFloor;
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {
     const double wanted = w[i] * f, floor = max_num(w[i], i % 7 < 3 ? w_length : w_rotation);

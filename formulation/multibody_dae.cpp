@@ -110,21 +110,15 @@ std::string MultibodyDae::component_name(int i) const {
 }
 
 double MultibodyDae::position_noise(const double* y) const {
-  double qmax = 1.0;
-  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
-  return 1e3 * 2.22e-16 * qmax;
+  return 1e3 * 2.22e-16 * max_num(1.0, max_abs(y, nq_));
 }
 
 double MultibodyDae::position_atol(const double* y, double atol) const {
-  double qmax = 0;
-  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
-  return max_num(atol, 10 * 2.22e-16 * qmax);
+  return max_num(atol, 10 * 2.22e-16 * max_abs(y, nq_));
 }
 
 double MultibodyDae::velocity_atol(double h, const double* y, double atol) const {
-  double qmax = 0, vmax = 0;
-  for (int i = 0; i < nq_; ++i) qmax = max_num(qmax, std::fabs(y[i]));
-  for (int i = nq_; i < 2 * nq_; ++i) vmax = max_num(vmax, std::fabs(y[i]));
+  const double qmax = max_abs(y, nq_), vmax = max_abs(y + nq_, nq_);
   const double step = newton_cj_ > 0 ? 1.0 / newton_cj_ : h;
   return max_num(atol, 10 * 2.22e-16 * max_num(vmax, qmax / step));
 }
@@ -149,12 +143,17 @@ void MultibodyDae::state_weights(double h, const double* y, double rtol, double 
   }
 }
 
+double MultibodyDae::position_magnitude(const double* y) const {
+  double rmax = abs_tol_.length;
+  for (int i = 0; i < nq_; i += 7) rmax = max_num(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
+  return rmax;
+}
+
 void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w) const {
   if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
   const double f = max_num(1.0, abs_tol_.span / h);
-  double rmax = abs_tol_.length, vmax = abs_tol_.length / abs_tol_.time;
-  for (int i = 0; i < nq_; i += 7) rmax = max_num(rmax, std::fabs(y[i]) + std::fabs(y[i + 1]) + std::fabs(y[i + 2]));
-  for (int i = nq_; i < 2 * nq_; ++i) vmax = max_num(vmax, std::fabs(y[i]));
+  const double rmax = position_magnitude(y);
+  const double vmax = max_num(abs_tol_.length / abs_tol_.time, max_abs(y + nq_, nq_));
   const double e = kSpanRoundingFloor;
   const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
   const double w_velocity = 1.0 / (e * max_num(vmax, rmax / noise_step));
@@ -302,8 +301,7 @@ double MultibodyDae::consistent_output(double t_in, const double* y, const doubl
       }
     }
     velocity_constraint_values(sys_, offsets_, q.data(), v.data(), t, out_phi_.data());
-    double vmax = 1.0;
-    for (int i = 0; i < nq_; ++i) vmax = max_num(vmax, std::fabs(v[i]));
+    const double vmax = max_num(1.0, max_abs(v.data(), nq_));
     if (state_.output_failure.empty() && max_abs(out_phi_.data(), nc_) > 1e-14 * vmax && !aug_.velocities(q.data(), t, v.data())) {
       std::snprintf(buf, sizeof buf, "output sample at t = %.17g: the projection onto the velocity constraints failed (singular constraint Jacobian)", t_in);
       state_.output_failure = buf;

@@ -161,6 +161,9 @@ class MultibodyDae : public DaeProblem {
   // time over which a position's rounding counts as velocity noise (h, or sqrt(h S) where that
   // noise adds up as a random walk: GglDae::error_weights).
   void error_per_unit_span(double h, double noise_step, const double* y, double* w) const;
+  // The model's position scale for the rounding floors: max(L, |x| + |y| + |z| of every body's
+  // origin), L the model's length (AbsoluteTolerances).
+  double position_magnitude(const double* y) const;
   static constexpr double kSpanRoundingFloor = 1e2 * 2.220446049250313e-16;
   // How often the error control asked for positions below their rounding: calls of the weights,
   // and those where the rounding floor replaced the control's tolerance for most position
