@@ -44,28 +44,27 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
   if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
   for (size_t i = 0; i < twins_.size(); ++i) {
     base_->derivative_times(y, sp[i], r[i]);
-    int flag = 0;
-    if (exact_) {
-      add_assembled_state_term(s[i], r[i]);
-      flag = add_parameter_term(t, y, yp, twins_[i], r[i]);
-    } else {
-      flag = add_difference_terms(t, y, yp, twins_[i], s[i], r[i]);
-    }
-    if (flag != 0) return flag;
+    if (exact_) add_assembled_state_term(s[i], r[i]);
+    // F_p alone after fall_back() (A0 s holds F_y s), else F_y s + F_p together.
+    if (const int flag = add_twin_difference(t, y, yp, twins_[i], exact_ ? nullptr : s[i], r[i]); flag != 0)
+      return flag;
   }
   return 0;
 }
 
-// r += F_y s + F_p = [F+(y + d s, y') - F-(y - d s, y')] / (2 d): the twins' central difference
-// along the state's direction s and the parameter together, two residuals.
-int TwinSensitivities::add_difference_terms(double t, const double* y, const double* yp, ParameterTwins& p,
-                                            const double* s, double* r) {
+// r += [F+(y + d s, y') - F-(y - d s, y')] / (2 d): the twins' central difference along the
+// state's direction s and the parameter together, F_y s + F_p, two residuals; without s (null),
+// at the same (y, y'): F_p alone.
+int TwinSensitivities::add_twin_difference(double t, const double* y, const double* yp, ParameterTwins& p,
+                                           const double* s, double* r) {
   const int n = run_.size();
   for (int sign = 1; sign >= -1; sign -= 2) {
     MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
     follow(twin);
-    for (int k = 0; k < n; ++k) yt_[k] = y[k] + sign * p.delta * s[k];
-    if (const int flag = twin.residual(t, yt_.data(), yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
+    if (s)
+      for (int k = 0; k < n; ++k) yt_[k] = y[k] + sign * p.delta * s[k];
+    if (const int flag = twin.residual(t, s ? yt_.data() : y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0)
+      return flag;
   }
   for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
   return 0;
@@ -76,17 +75,6 @@ void TwinSensitivities::add_assembled_state_term(const double* s, double* r) con
   const CscPattern& pat = base_->jacobian_pattern();
   for (int c = 0; c < run_.size(); ++c)
     for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[pat.rowind[k]] += a0_[k] * s[c];
-}
-
-// r += F_p by the twins at the same (y, y') (after fall_back()).
-int TwinSensitivities::add_parameter_term(double t, const double* y, const double* yp, ParameterTwins& p, double* r) {
-  for (int sign = 1; sign >= -1; sign -= 2) {
-    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
-    follow(twin);
-    if (const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
-  }
-  for (int k = 0; k < run_.size(); ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
-  return 0;
 }
 
 void TwinSensitivities::initial(double, const double*, const double*, double* const* s, double* const* sp) {

@@ -82,10 +82,9 @@ class TwinSensitivities : public SensitivityProblem {
 
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
-  int add_difference_terms(double t, const double* y, const double* yp, ParameterTwins& p, const double* s,
-                           double* r);
+  int add_twin_difference(double t, const double* y, const double* yp, ParameterTwins& p, const double* s,
+                          double* r);
   void add_assembled_state_term(const double* s, double* r) const;
-  int add_parameter_term(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
 
   MultibodyDae& run_;
   std::unique_ptr<MultibodyDae> base_;
