@@ -12,6 +12,12 @@ const std::vector<Formulation>& formulation_registry() {
        [](const System& s, const FormulationParameters& p) -> std::unique_ptr<MultibodyDae> {
          return std::make_unique<Index3Dae>(s, p.constraint_scale, true);
        }},
+      {"index3-no-handover",
+       "index3 at every rtol, also below 1e-6 where index3 runs as index2-ggl (formulation/index3_dae.h)", true,
+       false,
+       [](const System& s, const FormulationParameters& p) -> std::unique_ptr<MultibodyDae> {
+         return std::make_unique<Index3Dae>(s, p.constraint_scale, true);
+       }},
       {"index3-positions",
        "index-3 DAE with the error test on positions per step only, the former default (formulation/index3_dae.h)",
        true, false,
@@ -50,6 +56,10 @@ std::string formulation_names(bool last_or) {
   for (size_t k = 0; k < table.size(); ++k)
     s += (k == 0 ? "" : last_or && k + 1 == table.size() ? " or " : ", ") + table[k].name;
   return s;
+}
+
+std::string formulation_at(const std::string& name, double rtol) {
+  return name == "index3" && rtol < kIndex3HandoverRtol ? "index2-ggl" : name;
 }
 
 }  // namespace mbdae

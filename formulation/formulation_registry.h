@@ -52,4 +52,11 @@ const Formulation* find_formulation(const std::string& name);
 // "index3, index2-ggl, index1, penalty" (or with " or " before the last: `last_or`).
 std::string formulation_names(bool last_or = false);
 
+// Below this rtol "index3" runs as index2-ggl: index3's position test would ask for positions
+// below their rounding there, and its error stops falling with rtol (docs/formulation.md, "index3
+// hands over to index2-ggl below rtol 1e-6"). "index3-no-handover" is index3 at every rtol.
+constexpr double kIndex3HandoverRtol = 1e-6;
+// The formulation that integrates when `name` is asked at `rtol`.
+std::string formulation_at(const std::string& name, double rtol);
+
 }  // namespace mbdae

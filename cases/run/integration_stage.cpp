@@ -311,11 +311,39 @@ void note_rounding_floor(RunContext& c, const std::string& formulation, double r
   if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
 }
 
+// Whether the step runs at the rtol and atol its scene fixes: a scene's own tolerances keep its
+// formulation (the suspension's and the IFToMM scenes' were chosen with index3; index2-ggl does not
+// pass A02's singular configurations).
+bool scene_tolerances(const RunContext& c, const AnalysisStep& step) {
+  return step.atol > 0 && c.options.atol <= 0 && (c.options.rtol <= 0 || c.options.rtol == step.rtol);
+}
+
+// index3 asked below rtol 1e-6: the step records what was asked and why index2-ggl ran, in the
+// step and the summary's notes (on stderr unless quiet).
+void note_handover(RunContext& c, const std::string& asked, const std::string& used, double rtol, json& js) {
+  char buf[500];
+  std::snprintf(buf, sizeof buf,
+                "rtol %g: %s runs as %s below rtol %g, where index3's error test would ask for positions below "
+                "their rounding and its error would stop falling with rtol (docs/formulation.md); "
+                "index3-no-handover keeps index3",
+                rtol, asked.c_str(), used.c_str(), kIndex3HandoverRtol);
+  js["formulation_asked"] = asked;
+  js["formulation_handover"] = buf;
+  c.result.summary["notes"].push_back(buf);
+  if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
+}
+
 // The step's formulation: the run option's, else the step's. With sensitivities a scene's index3
 // step runs as index2-ggl, and says so (a formulation asked by name is refused before the run;
 // docs/sensitivities.md), except a kinematic step whose sensitivities need no integration.
-std::string step_formulation(const RunContext& c, const AnalysisStep& step, json& js) {
-  const std::string name = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+// A dynamics step's index3 below rtol 1e-6 runs as index2-ggl, and says so
+// (formulation/formulation_registry.h), unless the step runs at the tolerances its scene fixes.
+std::string step_formulation(RunContext& c, const AnalysisStep& step, double rtol, json& js) {
+  const std::string asked = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
+  const std::string name = scene_tolerances(c, step) || step.type != AnalysisStep::Type::kDynamics
+                               ? asked
+                               : formulation_at(asked, rtol);
+  if (name != asked) note_handover(c, asked, name, rtol, js);
   if (!c.sensitivities || !c.sensitivities->active || kinematic_by_ift(c, step) || sensitivity_formulation(name))
     return name;
   js["formulation_with_sensitivities"] = "index2-ggl instead of the scene's " + name + ": " + kIndex3SensitivityNote;
@@ -421,13 +449,13 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
 bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
   js["type"] = analysis_type(step.type).name;
-  const std::string name = step_formulation(c, step, js);
+  const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
+  const std::string name = step_formulation(c, step, rtol, js);
   const Formulation* f = find_formulation(name);
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");
   js["formulation"] = name;
   js["integrator"] = f->integrator_name;
-  const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
   const StepTolerances tol = step_tolerances(sys, c.q.data(), step, rtol, c.options.atol);
   IdaOptions io = integration_options(c.options, step, tol, js);
   const FormulationParameters fp = formulation_parameters(sys, *f, step, tol, js);

@@ -194,13 +194,44 @@ TEST(ErrorControlNotes, RoundingFloorIsNoted) {
     const double fraction = r.summary["steps"].back()["statistics"]["rounding_floor_fraction"].get<double>();
     return std::make_pair(r.summary.contains("notes") ? r.summary["notes"].size() : 0u, fraction);
   };
-  const auto tight = notes("index3", 1e-9);
+  const auto tight = notes("index3-no-handover", 1e-9);
   EXPECT_EQ(tight.first, 1u);
   EXPECT_GT(tight.second, 0.5);
   const auto loose = notes("index3", 1e-4);
   EXPECT_EQ(loose.first, 0u);
   EXPECT_LT(loose.second, 0.5);
   EXPECT_EQ(notes("index2-ggl", 1e-8).first, 0u);
+}
+
+// Below rtol 1e-6 a dynamics step's index3 runs as index2-ggl (formulation_registry.h): the step
+// names the formulation asked and the one that ran, and the summary says why. At 1e-6, and at a
+// scene's own fixed tolerances, index3 runs as asked; index3-no-handover keeps it at every rtol.
+TEST(ErrorControlNotes, Index3HandsOverBelowOneMillionth) {
+  const Scene scene = load_scene(source(kFast));
+  auto step_of = [&](const char* formulation, double rtol) {
+    RunOptions o;
+    o.rtol = rtol;
+    o.formulation = formulation;
+    const Result r = run(scene, o);
+    EXPECT_TRUE(r.ok()) << r.message;
+    return std::make_pair(r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array()));
+  };
+  const auto [tight, tight_notes] = step_of("index3", 1e-8);
+  EXPECT_EQ(tight["formulation"], "index2-ggl");
+  EXPECT_EQ(tight["formulation_asked"], "index3");
+  ASSERT_EQ(tight_notes.size(), 1u);
+  EXPECT_NE(tight_notes[0].get<std::string>().find("index3 runs as index2-ggl below rtol 1e-06"), std::string::npos);
+  const auto [at, at_notes] = step_of("index3", 1e-6);
+  EXPECT_EQ(at["formulation"], "index3");
+  EXPECT_FALSE(at.contains("formulation_asked"));
+  EXPECT_EQ(step_of("index3-no-handover", 1e-8).first["formulation"], "index3-no-handover");
+  Scene fixed = scene;  // the scene's own tight tolerances
+  fixed.steps.back().rtol = 1e-8;
+  fixed.steps.back().atol = 1e-10;
+  RunOptions o;
+  const Result r = run(fixed, o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_EQ(r.summary["steps"].back()["formulation"], "index3");
 }
 
 }  // namespace
