@@ -311,13 +311,6 @@ void note_rounding_floor(RunContext& c, const std::string& formulation, double r
   if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
 }
 
-// Whether the step runs at the rtol and atol its scene fixes: a scene's own tolerances keep its
-// formulation (the suspension's and the IFToMM scenes' were chosen with index3; index2-ggl does not
-// pass A02's singular configurations).
-bool scene_tolerances(const RunContext& c, const AnalysisStep& step) {
-  return step.atol > 0 && c.options.atol <= 0 && (c.options.rtol <= 0 || c.options.rtol == step.rtol);
-}
-
 // index3 asked below rtol 1e-6: the step records what was asked and why index2-ggl ran, in the
 // step and the summary's notes (on stderr unless quiet).
 void note_handover(RunContext& c, const std::string& asked, const std::string& used, double rtol, json& js) {
@@ -340,9 +333,7 @@ void note_handover(RunContext& c, const std::string& asked, const std::string& u
 // (formulation/formulation_registry.h), unless the step runs at the tolerances its scene fixes.
 std::string step_formulation(RunContext& c, const AnalysisStep& step, double rtol, json& js) {
   const std::string asked = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
-  const std::string name = scene_tolerances(c, step) || step.type != AnalysisStep::Type::kDynamics
-                               ? asked
-                               : formulation_at(asked, rtol);
+  const std::string name = step_formulation(step, c.options);
   if (name != asked) note_handover(c, asked, name, rtol, js);
   if (!c.sensitivities || !c.sensitivities->active || kinematic_by_ift(c, step) || sensitivity_formulation(name))
     return name;
@@ -445,6 +436,16 @@ void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const 
 }
 
 }  // namespace
+
+// A scene's own tolerances (its rtol and an atol of its own, the run giving neither) keep its
+// formulation: the suspension's and the IFToMM scenes' were chosen with index3, and index2-ggl
+// does not pass A02's singular configurations.
+std::string step_formulation(const AnalysisStep& step, const RunOptions& options) {
+  const std::string asked = !options.formulation.empty() ? options.formulation : step.formulation;
+  const bool scene_tolerances = step.atol > 0 && options.atol <= 0 && options.rtol <= 0;
+  if (scene_tolerances || step.type != AnalysisStep::Type::kDynamics) return asked;
+  return formulation_at(asked, options.rtol > 0 ? options.rtol : step.rtol);
+}
 
 bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;

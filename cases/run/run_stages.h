@@ -48,6 +48,10 @@ void output_columns(RunContext& c);
 bool assembly_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js);
 bool equilibrium_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js);
 bool integration_stage(RunContext& c, const AnalysisStep& step, nlohmann::ordered_json& js);
+// The formulation a step integrates with under `options` (sensitivities aside): the asked one, or
+// index2-ggl for a dynamics step's index3 below rtol 1e-6 that does not run at the tolerances its
+// scene fixes (formulation/formulation_registry.h, docs/formulation.md).
+std::string step_formulation(const AnalysisStep& step, const RunOptions& options);
 
 // Records a failed step: its status and message in the step and the summary, exit code 3.
 void fail(RunContext& c, const std::string& status, const std::string& message, nlohmann::ordered_json step);
