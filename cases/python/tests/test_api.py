@@ -45,6 +45,22 @@ def test_options_are_the_clis(tmp_path):
         mbdae.load(STEP).run(rtol=2)
 
 
+def test_index3_handover_is_the_clis_and_says_so(tmp_path):
+    # Below rtol 1e-6 a dynamics step's index3 runs as index2-ggl (docs/formulation.md), from
+    # Python as from the CLI; index3-no-handover keeps index3.
+    code, err = cli_run(STEP, tmp_path, "--rtol", "1e-7", "--output-step", "0.01")
+    assert code == 0, err
+    r = mbdae.load(STEP).run(rtol=1e-7, output_step=0.01)
+    step = r.summary["steps"][-1]
+    assert (step["formulation"], step["formulation_asked"]) == ("index2-ggl", "index3")
+    assert any("index3 runs as index2-ggl" in n for n in r.summary["notes"])
+    assert csv_text(r) == (tmp_path / "results.csv").read_text()
+    kept = mbdae.load(STEP).run(rtol=1e-7, output_step=0.01, formulation="index3-no-handover")
+    assert kept.summary["steps"][-1]["formulation"] == "index3-no-handover"
+    assert "formulation_asked" not in kept.summary["steps"][-1]
+    assert "index3-no-handover" in mbdae.formulations()
+
+
 @needs_analysis_option
 def test_analysis_option_stops_after_that_step():
     scene = mbdae.load(STEP)
