@@ -334,7 +334,7 @@ void note_handover(RunContext& c, const std::string& asked, const std::string& u
 // docs/sensitivities.md), except a kinematic step whose sensitivities need no integration.
 // A dynamics step's index3 below rtol 1e-6 runs as index2-ggl, and says so
 // (formulation/formulation_registry.h), unless the step runs at the tolerances its scene fixes.
-std::string step_formulation(RunContext& c, const AnalysisStep& step, double rtol, json& js) {
+std::string run_formulation(RunContext& c, const AnalysisStep& step, double rtol, json& js) {
   const std::string asked = !c.options.formulation.empty() ? c.options.formulation : step.formulation;
   const std::string name = step_formulation(step, c.options);
   if (name != asked) note_handover(c, asked, name, rtol, js);
@@ -454,7 +454,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   const System& sys = *c.system;
   js["type"] = analysis_type(step.type).name;
   const double rtol = c.options.rtol > 0 ? c.options.rtol : step.rtol;
-  const std::string name = step_formulation(c, step, rtol, js);
+  const std::string name = run_formulation(c, step, rtol, js);
   const Formulation* f = find_formulation(name);
   if (!f) throw ModelError(step.where.file, step.where.line, "formulation",
                            "unknown formulation '" + name + "' (" + formulation_names() + ")");

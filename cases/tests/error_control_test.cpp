@@ -180,17 +180,23 @@ TEST(ErrorEstimateApi, ClampedComparisonToleranceIsLabelled) {
   EXPECT_NEAR(e.to_json()["comparison"]["rtol"].get<double>(), 3e-14, 1e-27);
 }
 
+// The scene run with `formulation` at `rtol`, expected to succeed.
+Result run_with(const Scene& scene, const char* formulation, double rtol) {
+  RunOptions o;
+  o.rtol = rtol;
+  o.formulation = formulation;
+  Result r = run(scene, o);
+  EXPECT_TRUE(r.ok()) << r.message;
+  return r;
+}
+
 // The fast mechanism: index3's position tolerance sits at the rounding floor from about rtol
 // 1e-7 on (docs/formulation.md, "Index 3 at tight tolerances"); the run says so in a note. At
 // rtol 1e-4 it does not, nor does index2-ggl at 1e-8 (its floor is at about 1e-10).
 TEST(ErrorControlNotes, RoundingFloorIsNoted) {
   const Scene scene = load_scene(source(kFast));
   auto notes = [&](const char* formulation, double rtol) {
-    RunOptions o;
-    o.rtol = rtol;
-    o.formulation = formulation;
-    const Result r = run(scene, o);
-    EXPECT_TRUE(r.ok()) << r.message;
+    const Result r = run_with(scene, formulation, rtol);
     const double fraction = r.summary["steps"].back()["statistics"]["rounding_floor_fraction"].get<double>();
     return std::make_pair(r.summary.contains("notes") ? r.summary["notes"].size() : 0u, fraction);
   };
@@ -209,11 +215,7 @@ TEST(ErrorControlNotes, RoundingFloorIsNoted) {
 TEST(ErrorControlNotes, Index3HandsOverBelowOneMillionth) {
   const Scene scene = load_scene(source(kFast));
   auto step_of = [&](const char* formulation, double rtol) {
-    RunOptions o;
-    o.rtol = rtol;
-    o.formulation = formulation;
-    const Result r = run(scene, o);
-    EXPECT_TRUE(r.ok()) << r.message;
+    const Result r = run_with(scene, formulation, rtol);
     return std::make_pair(r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array()));
   };
   const auto [tight, tight_notes] = step_of("index3", 1e-8);
