@@ -49,9 +49,11 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
 }
 
 void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* w) const {
-  // Tolerances of q times (h/T)^2, never below the rounding of the coordinates (1e3 eps of the
-  // model's positions, 1e3 eps for Euler parameters), never looser than the plain test.
-  const double r = abs_tol_.time / h, f = max_num(1.0, r * r);
+  // Tolerances of q times (h/T)^2 min(S/T, kSpanCap), never below the rounding of the
+  // coordinates (1e3 eps of the model's positions, 1e3 eps for Euler parameters), never looser
+  // than the plain test.
+  const double span_factor = min_num(max_num(1.0, abs_tol_.span / abs_tol_.time), kSpanCap);
+  const double r = abs_tol_.time / h, f = max_num(1.0, r * r * span_factor);
   const double w_length = 1.0 / (kRoundingFloor * position_magnitude(y)), w_rotation = 1.0 / kRoundingFloor;
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {

@@ -58,8 +58,9 @@ json last_configuration(const System& sys, const std::vector<char>& modes, const
 // Whether the equations set aside as redundant at the start (`all` has them) are no longer the
 // dependent ones at q: then the message says so instead of a singular configuration.
 void check_degraded_choice(const System& sys, const System& all, const double* q, double t, double t_input,
-                           const std::string& reached, const std::string& solver_message, FailureDiagnosis& out) {
-  const EquationChoiceCheck ck = check_equation_choice(all, sys, q, t_input, kSingularRatio);
+                           double singular_ratio, const std::string& reached, const std::string& solver_message,
+                           FailureDiagnosis& out) {
+  const EquationChoiceCheck ck = check_equation_choice(all, sys, q, t_input, singular_ratio);
   out.degraded_choice = ck.degraded;
   out.details["equation_choice"] = {{"degraded", ck.degraded},         {"kept_ratio", ck.kept_ratio},
                                     {"rechosen_ratio", ck.rechosen_ratio}, {"set_aside", ck.set_aside},
@@ -119,11 +120,13 @@ FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vect
                                         {"equations", r.equations},
                                         {"losing_rank", r.constraints},
                                         {"dependent_equations", dependent}};
-  if (!out.singular) return out;
-  if (all && all->num_constraint_rows() > sys.num_constraint_rows()) {
-    check_degraded_choice(sys, *all, q, t, t_input, reached, solver_message, out);
+  const bool set_aside = all && all->num_constraint_rows() > sys.num_constraint_rows();
+  if (set_aside && (out.singular || ratio < kNearlySingularRatio)) {
+    check_degraded_choice(sys, *all, q, t, t_input, out.singular ? kSingularRatio : kNearlySingularRatio, reached,
+                          solver_message, out);
     if (out.degraded_choice) return out;
   }
+  if (!out.singular) return out;
   out.message = singular_message(r, t, condition, reached, targets, solver_message);
   return out;
 }

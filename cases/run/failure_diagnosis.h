@@ -16,6 +16,11 @@ namespace mbdae {
 // The Jacobian counts as singular where the row-normalized Phi_q has s_min / s_max below this
 // (the suspension's values along its kinematic drive: docs/extreme-cases.md).
 constexpr double kSingularRatio = 1e-4;
+// With equations set aside, a failure where the kept ones are nearly singular (below this) while
+// the equations chosen again at q are not is told as a degraded choice too: the corrector can
+// fail before the kept Jacobian is singular (index2-ggl on the turntable four-bar with the world
+// choice: s_min / s_max 3.8e-4 at the failure, just before the quarter turn).
+constexpr double kNearlySingularRatio = 1e-2;
 // The message names the joints, cuts and drives with an equation of at least this weight.
 constexpr double kNamedWeight = 0.5;
 
@@ -31,7 +36,8 @@ struct FailureDiagnosis {
 // `condition` is the constraint condition estimate at q (AugmentedSolver::constraint_condition).
 // `all`, if given, is the system with every equation as built (sys without its redundant ones):
 // a singular Jacobian is then told apart as the mechanism's or the equation choice's
-// (check_equation_choice), and the message says which.
+// (check_equation_choice), and the message says which; a nearly singular one
+// (kNearlySingularRatio) is told as the choice's when it is.
 FailureDiagnosis diagnose_integration_failure(const System& sys, const std::vector<char>& modes,
                                               const std::vector<int>& columns, const double* q,
                                               const double* v, double t, double t_input,

@@ -90,22 +90,46 @@ TEST_P(TurningLoop, RunsToTheEndWithTheRightMotion) {
 // index3 fails where the kept equations go singular and the diagnosis says the choice degraded,
 // not the mechanism; index1 and penalty (which ended 1.3 rad off before the watch) stop at the
 // first sample where the equations set aside no longer hold.
+// The failure at a degraded world choice: its diagnosis, at a quarter turn (the loop's normal
+// along world x), with the equations chosen again named.
+void expect_degraded_choice(const Result& r, const std::string& formulation) {
+  EXPECT_EQ(r.status, "integration_failed") << formulation;
+  EXPECT_NE(r.message.find("(a degraded equation choice, not a singular configuration)"), std::string::npos)
+      << formulation << ": " << r.message;
+  const auto& step = r.summary["steps"].back();
+  ASSERT_TRUE(step.contains("equation_choice")) << formulation << ": " << step.dump(1);
+  EXPECT_TRUE(step["equation_choice"]["degraded"].get<bool>()) << formulation;
+  EXPECT_EQ(step["equation_choice"]["set_aside_again"].get<int>(), 3) << formulation;
+  const double t = step["t_reached"].get<double>();
+  EXPECT_NEAR(std::fmod(t, 0.5), 0.25, 0.01) << formulation << ": " << t;
+}
+
+// With the world choice the kept equations go singular at every quarter turn. A run either stops
+// there with the diagnosis or steps over it with the right motion (within the promise), never
+// `ok` with a wrong one. Measured: index3 steps over the quarter turns and ends `ok` (since its
+// position test per unit of the span; before, it failed at t = 2.25 s with the diagnosis),
+// index2-ggl fails at the first one (0.2495 s, s_min / s_max 3.8e-4: the nearly singular case of
+// cases/run/failure_diagnosis.h), index1 and penalty stop at the watch on the equations set
+// aside.
 TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
   Scene scene = load_turning_case(kTurntableFourBar);
   scene.redundant_constraints = "remove_world";
   RunOptions opt;
   opt.progress = false;
+  opt.verbose = false;
   opt.formulation = "index3";
   const Result r3 = run(scene, opt);
-  EXPECT_EQ(r3.status, "integration_failed");
-  EXPECT_NE(r3.message.find("(a degraded equation choice, not a singular configuration)"), std::string::npos)
-      << r3.message;
-  const auto& step = r3.summary["steps"].back();
-  ASSERT_TRUE(step.contains("equation_choice")) << step.dump(1);
-  EXPECT_TRUE(step["equation_choice"]["degraded"].get<bool>());
-  EXPECT_EQ(step["equation_choice"]["set_aside_again"].get<int>(), 3);
-  const double t3 = step["t_reached"].get<double>();
-  EXPECT_NEAR(std::fmod(t3, 0.5), 0.25, 0.01) << t3;  // a quarter turn, the loop's normal along world x
+  if (r3.ok()) {
+    const double rtol = scene.steps.back().rtol;
+    const TurningErrors e = turning_errors(kTurntableFourBar, r3);
+    std::printf("index3, world choice: ok, largest error / scale %.3g (%.3g rtol)\n", e.worst, e.worst / rtol);
+    EXPECT_EQ(r3.rows(), 301u);
+    EXPECT_LE(e.worst, 10 * rtol);
+  } else {
+    expect_degraded_choice(r3, "index3");
+  }
+  opt.formulation = "index2-ggl";
+  expect_degraded_choice(run(scene, opt), "index2-ggl");
   for (const char* f : {"index1", "penalty"}) {
     opt.formulation = f;
     const Result r = run(scene, opt);
