@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/finite_check.h"
+#include "formulation/formulation_registry.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -40,7 +41,7 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
   const double av = atol + noise / h, al = mass_scale_ * (atol + noise / (h * h));
   if (per_unit_step_ && abs_tol_.set()) {
     state_weights(h, y, rtol, atol, w);
-    velocity_error_per_unit_step(newton_step(h), y, w);
+    velocity_error_per_unit_step(newton_step(h), y, rtol, w);
   } else {
     position_weights(y, rtol, position_atol(y, atol), w);
   }
@@ -48,11 +49,12 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 
-void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double* w) const {
-  // Tolerances of q times (h/T)^2 min(S/T, kSpanCap), never below the rounding of the
-  // coordinates (1e3 eps of the model's positions, 1e3 eps for Euler parameters), never looser
-  // than the plain test.
-  const double span_factor = min_num(max_num(1.0, abs_tol_.span / abs_tol_.time), kSpanCap);
+void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double rtol, double* w) const {
+  // Tolerances of q times (h/T)^2 c, c = S/T at most kSpanCap and at most rtol / 1e-6 (the
+  // handover's rtol), never below the rounding of the coordinates (1e3 eps of the model's
+  // positions, 1e3 eps for Euler parameters), never looser than the plain test.
+  const double span_factor =
+      max_num(1.0, min_num(min_num(abs_tol_.span / abs_tol_.time, kSpanCap), rtol / kIndex3HandoverRtol));
   const double r = abs_tol_.time / h, f = max_num(1.0, r * r * span_factor);
   const double w_length = 1.0 / (kRoundingFloor * position_magnitude(y)), w_rotation = 1.0 / kRoundingFloor;
   int floored = 0;

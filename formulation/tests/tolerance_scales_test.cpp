@@ -72,25 +72,28 @@ TEST(ToleranceScales, Index3VelocityErrorPerUnitStep) {
   const double floor_rotation = 1e3 * 2.220446049250313e-16;
   plain.error_weights(1e-3, y.data(), rtol, a.position, w0.data());
   for (int i = 0; i < 7; ++i) EXPECT_DOUBLE_EQ(w0[i], 1.0 / (rtol * std::fabs(y[i]) + a.position));
-  // h = T / 10: the weights times (T/h)^2 = 100 and the span factor S / T, capped at 5 (a 1 s
-  // run, S / T = 18 here), above the floor.
+  // h = T / 10: at rtol 1e-6 (the handover's) the weights times (T/h)^2 = 100, above the floor.
   const double h = s.time / 10;
-  ASSERT_GT(a.span / a.time, 10.0);
   unit_step.error_weights(h, y.data(), rtol, a.position, w.data());
   for (int i = 0; i < 7; ++i) {
     const double plain_w = 1.0 / (rtol * std::fabs(y[i]) + (i < 3 ? a.position : a.rotation));
-    EXPECT_NEAR(w[i], 100 * 5 * plain_w, 1e-9 * w[i]) << i;
+    EXPECT_NEAR(w[i], 100 * plain_w, 1e-9 * w[i]) << i;
   }
-  // Below the cap S / T itself (a run of 3 T), and never below 1 (T is never more than S).
-  for (const double periods : {3.0, 0.5}) {
-    const ModelScales sl = model_scales(sys, sys.q0.data(), 0.0, periods * s.time);
-    const AbsoluteTolerances al = absolute_tolerances(sl, default_position_atol(sl, rtol));
+  // Looser, also times the span factor c = S / T, at most 5 and at most rtol / 1e-6: a 1 s run
+  // (S / T = 18 here) at rtol 1e-4 and 3e-6, a run of 3 T at 1e-4.
+  ASSERT_GT(a.span / a.time, 10.0);
+  struct Case {
+    double periods, rtol, c;
+  };
+  for (const Case k : {Case{0, 1e-4, 5.0}, Case{0, 3e-6, 3.0}, Case{3, 1e-4, 3.0}}) {
+    const ModelScales sl = k.periods > 0 ? model_scales(sys, sys.q0.data(), 0.0, k.periods * s.time) : s;
+    const AbsoluteTolerances al = absolute_tolerances(sl, default_position_atol(sl, k.rtol));
     Index3Dae span_test(sys, 1.0, true);
     span_test.set_absolute_tolerances(al);
-    span_test.error_weights(sl.time / 10, y.data(), rtol, al.position, w.data());
+    span_test.error_weights(sl.time / 10, y.data(), k.rtol, al.position, w.data());
     for (int i = 0; i < 7; ++i) {
-      const double plain_w = 1.0 / (rtol * std::fabs(y[i]) + (i < 3 ? al.position : al.rotation));
-      EXPECT_NEAR(w[i], 100 * std::max(1.0, periods) * plain_w, 1e-9 * w[i]) << periods << " T, " << i;
+      const double plain_w = 1.0 / (k.rtol * std::fabs(y[i]) + (i < 3 ? al.position : al.rotation));
+      EXPECT_NEAR(w[i], 100 * k.c * plain_w, 1e-9 * w[i]) << k.periods << " T, rtol " << k.rtol << ", " << i;
     }
   }
   // h = T / 1e6: (T/h)^2 = 1e12 would ask for less than the rounding: the floor.
