@@ -5,8 +5,9 @@
 // length scale); the largest error of the position and of the velocity outputs, relative to the
 // largest magnitude of their reference, must be within 10 rtol, at three rtols per formulation.
 // The rtols are those where the formulation keeps the promise on both (docs/formulation.md
-// "Error control", where the misses outside them are measured): index3 1e-4 .. 1e-6 (A01 misses
-// at 1e-3 by 1.3 and at 1e-2 by 12) and, run as index2-ggl below rtol 1e-6, 1e-8 and 1e-10
+// "Error control", where the misses outside them are measured): index3 1e-2 .. 1e-6 (A01 missed
+// at 1e-3 by 1.3 and at 1e-2 by 12 before its position test per unit of the span) and, run as
+// index2-ggl below rtol 1e-6, 1e-8 and 1e-10
 // (index3-no-handover stops near 3e-7 and 1.3e-6 relative from rtol 1e-7 on),
 // index2-ggl 1e-4 .. 1e-10 (its velocity floor at the random walk of a position's rounding per
 // step), index1 1e-4 .. 1e-8,
@@ -105,7 +106,7 @@ TEST_P(Promise, FastMechanism) { expect_promise(GetParam().formulation, "fast me
 TEST_P(Promise, A01TenSeconds) { expect_promise(GetParam().formulation, "A01 (10 s)", a01, GetParam().rtol); }
 
 INSTANTIATE_TEST_SUITE_P(Formulations, Promise,
-                         ::testing::Values(Case{"index3", 1e-4}, Case{"index3", 1e-5}, Case{"index3", 1e-6},
+                         ::testing::Values(Case{"index3", 1e-2}, Case{"index3", 1e-3}, Case{"index3", 1e-4}, Case{"index3", 1e-5}, Case{"index3", 1e-6},
                                            Case{"index3", 1e-8}, Case{"index3", 1e-10},
                                            Case{"index2-ggl", 1e-4}, Case{"index2-ggl", 1e-7},
                                            Case{"index2-ggl", 1e-10}, Case{"index1", 1e-4}, Case{"index1", 1e-6},
