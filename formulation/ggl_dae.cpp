@@ -64,7 +64,9 @@ void GglDae::error_weights(double h, const double* y, double rtol, double atol, 
     // eps |r| / h sqrt(S / h): a velocity tolerance below eps |r| / sqrt(h S) would ask the
     // run's summed errors for less than that noise (docs/formulation.md, "Error control").
     const double step = newton_step(h);
-    error_per_unit_span(step, std::sqrt(step * absolute_tolerances().span), y, w);
+    // Its velocity errors add up into the positions over the run as well (a drifting phase):
+    // the velocities' per-unit-span tolerance times 1 / span_factor (docs/formulation.md).
+    error_per_unit_span(step, std::sqrt(step * absolute_tolerances().span), y, w, span_factor(rtol));
   } else {
     position_weights(y, rtol, aq, w);
     for (int i = nq_; i < 2 * nq_; ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + av);

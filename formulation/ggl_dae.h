@@ -42,7 +42,7 @@ class GglDae : public MultibodyDae {
   void error_test_mask(double* id) const override;
   // Newton-test (and error-test) weights. Positions: rtol|q| + atol. Velocities: rtol|v| +
   // atol (with v in the test: both per unit of the run's span, times h / S, error_per_unit_span,
-  // when the model's tolerances are set), plus the rounding floor of the positions amplified by 1/h when v is out of the
+  // when the model's tolerances are set, v's also times 1 / span_factor(rtol)), plus the rounding floor of the positions amplified by 1/h when v is out of the
   // error test (atol floored at ten roundings of the largest |q|, |v|). The index-2 multipliers are a correction per step, of the size of the
   // error of q (mu) or of M v (lambda) divided by h: rtol|mu| + (atol + noise)/h and
   // rtol|lambda| + m_ref (atol + noise/h)/h.

@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "core/finite_check.h"
-#include "formulation/formulation_registry.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -50,12 +49,10 @@ void Index3Dae::error_weights(double h, const double* y, double rtol, double ato
 }
 
 void Index3Dae::velocity_error_per_unit_step(double h, const double* y, double rtol, double* w) const {
-  // Tolerances of q times (h/T)^2 c, c = S/T at most kSpanCap and at most rtol / 1e-6 (the
-  // handover's rtol), never below the rounding of the coordinates (1e3 eps of the model's
-  // positions, 1e3 eps for Euler parameters), never looser than the plain test.
-  const double span_factor =
-      max_num(1.0, min_num(min_num(abs_tol_.span / abs_tol_.time, kSpanCap), rtol / kIndex3HandoverRtol));
-  const double r = abs_tol_.time / h, f = max_num(1.0, r * r * span_factor);
+  // Tolerances of q times (h/T)^2 c (c = span_factor(rtol)), never below the rounding of the
+  // coordinates (1e3 eps of the model's positions, 1e3 eps for Euler parameters), never looser
+  // than the plain test.
+  const double r = abs_tol_.time / h, f = max_num(1.0, r * r * span_factor(rtol));
   const double w_length = 1.0 / (kRoundingFloor * position_magnitude(y)), w_rotation = 1.0 / kRoundingFloor;
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {

@@ -35,10 +35,10 @@ class Index3Dae : public MultibodyDae {
   // tolerances in model units times (h/T)^2 c, T the model's time scale: at index 3, v is the BDF
   // derivative of q, a local position error d gives a velocity error of about d/h, and (h/T)^2
   // keeps that below the velocity tolerance times h/T, so that the velocity errors of the steps
-  // add up to about the velocity tolerance over T. c = min(S/T, kSpanCap, rtol / 1e-6) (at least
-  // 1), S the run's span: the errors add up over the run, not over T; the cap bounds what that
-  // costs a long run, and rtol / 1e-6 keeps the rounding floor from coming sooner than without c
-  // at the handover's rtol (formulation_registry.h). Never below the rounding of the
+  // add up to about the velocity tolerance over T. c = min(S/T, 5, rtol / 1e-6) (at least 1,
+  // span_factor), S the run's span: the errors add up over the run, not over T; the cap bounds
+  // what that costs a long run, and rtol / 1e-6 keeps the rounding floor from coming sooner than
+  // without c at the handover's rtol (formulation_registry.h). Never below the rounding of the
   // coordinates, never looser than the plain test. Without (index3-positions): rtol|q| + atol.
   // Velocities and multipliers are out of the error test; rounding in the position-level
   // constraints (eps) reaches them as eps/h and eps/h^2, so their tolerances are those of the
@@ -59,9 +59,6 @@ class Index3Dae : public MultibodyDae {
   void velocity_error_per_unit_step(double h, const double* y, double rtol, double* w) const;
   // Rounding floor of the tested coordinates, relative to the model's positions (1e3 eps).
   static constexpr double kRoundingFloor = 1e3 * 2.220446049250313e-16;
-  // Largest span factor S/T of the position test (docs/formulation.md, "index3 per unit of the
-  // span, capped").
-  static constexpr double kSpanCap = 5.0;
   bool per_unit_step_;
 };
 

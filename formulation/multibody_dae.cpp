@@ -6,6 +6,7 @@
 #include "core/errors.h"
 #include "core/finite_check.h"
 #include "formulation/constraint_rates.h"
+#include "formulation/formulation_registry.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -149,7 +150,12 @@ double MultibodyDae::position_magnitude(const double* y) const {
   return rmax;
 }
 
-void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w) const {
+double MultibodyDae::span_factor(double rtol) const {
+  return max_num(1.0, min_num(min_num(abs_tol_.span / abs_tol_.time, kSpanCap), rtol / kIndex3HandoverRtol));
+}
+
+void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w,
+                                       double velocity_factor) const {
   if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
   const double f = max_num(1.0, abs_tol_.span / h);
   const double rmax = position_magnitude(y);
@@ -164,7 +170,7 @@ void MultibodyDae::error_per_unit_span(double h, double noise_step, const double
     const double wanted = w[i] * f, floor = max_num(w[i], euler ? w_rotation : w_length);
     floored += wanted > floor;
     w[i] = min_num(wanted, floor);
-    w[nq_ + i] = min_num(w[nq_ + i] * f, max_num(w[nq_ + i], euler ? w_rate : w_velocity));
+    w[nq_ + i] = min_num(w[nq_ + i] * f * velocity_factor, max_num(w[nq_ + i], euler ? w_rate : w_velocity));
   }
   count_floor(floored);
 }

@@ -159,8 +159,16 @@ class MultibodyDae : public DaeProblem {
   // over the run; never looser than before, never tighter than 100 roundings of the model's
   // positions (max(L, |r|)) and velocities (max(L/T, |v|, |r| / noise_step)): `noise_step` is the
   // time over which a position's rounding counts as velocity noise (h, or sqrt(h S) where that
-  // noise adds up as a random walk: GglDae::error_weights).
-  void error_per_unit_span(double h, double noise_step, const double* y, double* w) const;
+  // noise adds up as a random walk: GglDae::error_weights). The velocities' weights are further
+  // tightened by `velocity_factor` (GglDae: span_factor).
+  void error_per_unit_span(double h, double noise_step, const double* y, double* w,
+                           double velocity_factor = 1.0) const;
+  // The span factor c of a control whose velocity errors add up into positions over the run (a
+  // phase that drifts): S / T, at most kSpanCap and at most rtol / 1e-6, the rtol of index3's
+  // handover (at the handover's rtol the control measured down to its rounding floor), at least 1
+  // (docs/formulation.md, "index3 per unit of the span, capped").
+  double span_factor(double rtol) const;
+  static constexpr double kSpanCap = 5.0;
   // The model's position scale for the rounding floors: max(L, |x| + |y| + |z| of every body's
   // origin), L the model's length (AbsoluteTolerances).
   double position_magnitude(const double* y) const;
