@@ -286,7 +286,7 @@ def _execute(scene, todo, params, out, client, metrics, options, workers, retrie
                 for fut in pending:
                     rows[futures[fut]] = _record(out, index[futures[fut]], futures[fut], params[futures[fut]],
                                                  {"row": {"status": "lost", "message": message}}, defs)
-                    fut.cancel()
+                bk.cancel(pending)
                 print(f"mbdae sweep: {message}", file=sys.stderr)
                 pending = set()
         clean = True

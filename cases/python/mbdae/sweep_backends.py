@@ -5,7 +5,30 @@ Dask cluster (a distributed.Client or a scheduler address). Each backend submits
 for the next finished ones with a timeout, and says when it has had no worker for too long."""
 import concurrent.futures
 import os
+import threading
 import time
+
+# Seconds any one call to the Dask scheduler may take here: with its workers killed a scheduler
+# can stop answering (dask/distributed#3196), and a sweep must still end in bounded time.
+SCHEDULER_CALL_TIMEOUT = 5.0
+
+
+def _bounded(fn, *args):
+    """Calls fn(*args) in a daemon thread and waits at most SCHEDULER_CALL_TIMEOUT seconds: True
+    if it returned, False if it raised or is still waiting (then it is left behind)."""
+    outcome = []
+
+    def call():
+        try:
+            fn(*args)
+            outcome.append(True)
+        except Exception:  # noqa: BLE001 -- a lost scheduler: the caller goes on without it
+            outcome.append(False)
+
+    t = threading.Thread(target=call, daemon=True, name="mbdae-sweep-dask-call")
+    t.start()
+    t.join(SCHEDULER_CALL_TIMEOUT)
+    return bool(outcome and outcome[0])
 
 
 class Threads:
@@ -24,6 +47,10 @@ class Threads:
 
     def no_workers_for(self):
         return 0.0
+
+    def cancel(self, futures):
+        for f in futures:
+            f.cancel()
 
     def close(self, cancel=False):
         # On an error or Ctrl-C the queued runs are cancelled; runs already solving end with
@@ -60,19 +87,22 @@ class Dask:
     def no_workers_for(self):
         """Seconds since the cluster last had a worker (0 while it has one)."""
         try:
-            has_workers = bool(self.client.nthreads())
-        except Exception:  # noqa: BLE001 -- a lost scheduler counts as no workers
+            has_workers = bool(self.client.nthreads(callback_timeout=SCHEDULER_CALL_TIMEOUT))
+        except Exception:  # noqa: BLE001 -- a lost or silent scheduler counts as no workers
             has_workers = False
         now = time.monotonic()
         if has_workers:
             self.since_workers = now
         return now - self.since_workers
 
+    def cancel(self, futures):
+        _bounded(self.client.cancel, list(futures))
+
     def close(self, cancel=False):
         if self.own:
-            self.client.close()
+            _bounded(self.client.close)
             if self.cluster is not None:
-                self.cluster.close()
+                _bounded(self.cluster.close)
 
 
 def backend(client, workers, retries):
