@@ -155,15 +155,16 @@ double MultibodyDae::span_factor(double rtol) const {
 }
 
 void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w,
-                                       double velocity_factor) const {
+                                       double velocity_factor, double velocity_roundings) const {
   if (!abs_tol_.set() || !(abs_tol_.span > 0)) return;
   const double f = max_num(1.0, abs_tol_.span / h);
   const double rmax = position_magnitude(y);
   const double vmax = max_num(abs_tol_.length / abs_tol_.time, max_abs(y + nq_, nq_));
   const double e = kSpanRoundingFloor;
   const double w_length = 1.0 / (e * rmax), w_rotation = 1.0 / e;
-  const double w_velocity = 1.0 / (e * max_num(vmax, rmax / noise_step));
-  const double w_rate = 1.0 / (e * max_num(1.0, 1.0 / noise_step));
+  const double ev = velocity_roundings * 2.220446049250313e-16;
+  const double w_velocity = 1.0 / (ev * max_num(vmax, rmax / noise_step));
+  const double w_rate = 1.0 / (ev * max_num(1.0, 1.0 / noise_step));
   int floored = 0;
   for (int i = 0; i < nq_; ++i) {
     const bool euler = i % 7 >= 3;

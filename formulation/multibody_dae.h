@@ -160,9 +160,10 @@ class MultibodyDae : public DaeProblem {
   // positions (max(L, |r|)) and velocities (max(L/T, |v|, |r| / noise_step)): `noise_step` is the
   // time over which a position's rounding counts as velocity noise (h, or sqrt(h S) where that
   // noise adds up as a random walk: GglDae::error_weights). The velocities' weights are further
-  // tightened by `velocity_factor` (GglDae: span_factor).
-  void error_per_unit_span(double h, double noise_step, const double* y, double* w,
-                           double velocity_factor = 1.0) const;
+  // tightened by `velocity_factor` (GglDae: span_factor), and their floor is `velocity_roundings`
+  // roundings instead of 100 (Index1Dae: 10).
+  void error_per_unit_span(double h, double noise_step, const double* y, double* w, double velocity_factor = 1.0,
+                           double velocity_roundings = 100.0) const;
   // The span factor c of a control whose velocity errors add up into positions over the run (a
   // phase that drifts): S / T, at most kSpanCap and at most rtol / 1e-6, the rtol of index3's
   // handover (at the handover's rtol the control measured down to its rounding floor), at least 1
