@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "formulation/ggl_dae.h"
+#include "formulation/index1_dae.h"
 #include "formulation/index3_dae.h"
 #include "formulation/system.h"
 #include "formulation/tests/test_models.h"
@@ -99,6 +101,36 @@ TEST(ToleranceScales, Index3VelocityErrorPerUnitStep) {
   // h = T / 1e6: (T/h)^2 = 1e12 would ask for less than the rounding: the floor.
   unit_step.error_weights(s.time / 1e6, y.data(), rtol, a.position, w.data());
   for (int i = 0; i < 7; ++i) EXPECT_NEAR(w[i], 1.0 / (i < 3 ? floor_length : floor_rotation), 1e-9 * w[i]) << i;
+}
+// index2-ggl's velocity weights per unit of the span are also times the span factor
+// c = min(S / T, 5, rtol / 1e-6) (its velocity errors add up into the positions over the run);
+// its positions' are index1's, whose velocities have no such factor (a 1 s run, S / T = 18).
+TEST(ToleranceScales, GglVelocitiesPerUnitSpanTimesTheSpanFactor) {
+  Model m = testing::pendulum(2.0, 0.03, 0.1, 0.0);
+  m.gravity = Vec3(0, 0, -9.81);
+  const System sys = build_system(m);
+  const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 1.0);
+  ASSERT_GT(s.span / s.time, 10.0);
+  struct Case {
+    double rtol, c;
+  };
+  for (const Case k : {Case{1e-4, 5.0}, Case{3e-6, 3.0}, Case{1e-6, 1.0}}) {
+    const AbsoluteTolerances a = absolute_tolerances(s, default_position_atol(s, k.rtol));
+    GglDae ggl(sys);
+    Index1Dae index1(sys);
+    ggl.set_absolute_tolerances(a);
+    index1.set_absolute_tolerances(a);
+    const int nq = static_cast<int>(sys.q0.size());
+    std::vector<double> yg(ggl.size(), 0.0), yi(index1.size(), 0.0), wg(ggl.size()), wi(index1.size());
+    std::copy(sys.q0.begin(), sys.q0.end(), yg.begin());
+    std::copy(sys.q0.begin(), sys.q0.end(), yi.begin());
+    ggl.error_weights(s.time / 10, yg.data(), k.rtol, a.position, wg.data());
+    index1.error_weights(s.time / 10, yi.data(), k.rtol, a.position, wi.data());
+    for (int i = 0; i < nq; ++i) {
+      EXPECT_NEAR(wg[i], wi[i], 1e-12 * wi[i]) << "rtol " << k.rtol << ", q " << i;
+      EXPECT_NEAR(wg[nq + i], k.c * wi[nq + i], 1e-12 * wg[nq + i]) << "rtol " << k.rtol << ", v " << i;
+    }
+  }
 }
 
 }  // namespace
