@@ -275,8 +275,8 @@ def _execute(scene, todo, params, out, client, metrics, options, workers, retrie
             for fut in done:
                 k = futures[fut]
                 try:
-                    payload = fut.result()
-                except Exception as e:  # noqa: BLE001 -- a worker lost too often, a task error
+                    payload = bk.result(fut, worker_timeout)
+                except Exception as e:  # noqa: BLE001 -- a worker lost too often, a task error, a lost result
                     payload = {"row": {"status": "lost", "message": f"{type(e).__name__}: {e}"}}
                 rows[k] = _record(out, index[k], k, params[k], payload, defs)
                 bar.update(rows[k]["status"])

@@ -45,6 +45,9 @@ class Threads:
         done, pending = concurrent.futures.wait(pending, timeout, concurrent.futures.FIRST_COMPLETED)
         return done, pending
 
+    def result(self, future, timeout):
+        return future.result()
+
     def no_workers_for(self):
         return 0.0
 
@@ -77,12 +80,20 @@ class Dask:
         return self.client.submit(fn, *args, key=key, pure=False, retries=self.retries)
 
     def wait(self, pending, timeout):
-        from distributed import wait
-        try:
-            done, not_done = wait(list(pending), timeout=timeout, return_when="FIRST_COMPLETED")
-        except TimeoutError:
-            return set(), pending
-        return set(done), set(not_done)
+        # The futures' own state, polled: no call to the scheduler (distributed.wait goes through
+        # the client's event loop and waits without a limit if that loop stalls).
+        deadline = time.monotonic() + timeout
+        while True:
+            done = {f for f in pending if f.done()}
+            if done or time.monotonic() >= deadline:
+                return done, set(pending) - done
+            time.sleep(0.02)
+
+    def result(self, future, timeout):
+        """A finished run's payload, fetched from its worker within `timeout` seconds: a worker
+        killed after finishing takes the result with it, and without a limit the fetch would wait
+        for a recomputation that no worker is left to make."""
+        return future.result(timeout=timeout)
 
     def no_workers_for(self):
         """Seconds since the cluster last had a worker (0 while it has one)."""
