@@ -161,7 +161,7 @@ class MultibodyDae : public DaeProblem {
   // time over which a position's rounding counts as velocity noise (h, or sqrt(h S) where that
   // noise adds up as a random walk: GglDae::error_weights). The velocities' weights are further
   // tightened by `velocity_factor` (GglDae: span_factor), and their floor is `velocity_roundings`
-  // roundings instead of 100 (Index1Dae: 10).
+  // roundings instead of 100 (Index1Dae: 5).
   void error_per_unit_span(double h, double noise_step, const double* y, double* w, double velocity_factor = 1.0,
                            double velocity_roundings = 100.0) const;
   // The span factor c of a control whose velocity errors add up into positions over the run (a
