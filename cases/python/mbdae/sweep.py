@@ -5,6 +5,7 @@ takes the folder's lock, expands the grid, reuses the runs already finished in `
 verified), submits one task per remaining run (to threads of this process by default, or to
 Dask) and writes every file; each task applies its overrides to the scene, runs it, computes
 the metrics and returns its row and its columns. See docs/python.md."""
+import asyncio
 import itertools
 import os
 import socket
@@ -276,7 +277,11 @@ def _execute(scene, todo, params, out, client, metrics, options, workers, retrie
                 k = futures[fut]
                 try:
                     payload = bk.result(fut, worker_timeout)
-                except Exception as e:  # noqa: BLE001 -- a worker lost too often, a task error, a lost result
+                except (TimeoutError, asyncio.TimeoutError):  # the same class from Python 3.11 on
+                    payload = {"row": {"status": "lost", "message": (
+                        f"the finished run's result was not fetched within {worker_timeout:g} s ({bk.name}): its "
+                        "worker died after finishing; the run is repeated by the next sweep into this folder")}}
+                except Exception as e:  # noqa: BLE001 -- a worker lost too often, a task error
                     payload = {"row": {"status": "lost", "message": f"{type(e).__name__}: {e}"}}
                 rows[k] = _record(out, index[k], k, params[k], payload, defs)
                 bar.update(rows[k]["status"])

@@ -101,7 +101,10 @@ def test_a_sweep_whose_workers_all_die_ends_in_bounded_time(tmp_path):
         stop(procs)
     lost = table[table["status"] == "lost"]
     assert len(lost) > 0 and (table["status"].isin(["ok", "lost"])).all(), table["status"].value_counts()
-    assert lost["message"].str.contains("no Dask worker for 5 s").all()
+    # Lost for want of a worker, or, for a run that finished on a worker killed before its result
+    # was fetched, for want of the result (without the limit that fetch waited forever).
+    assert lost["message"].str.contains("no Dask worker for 5 s|result was not fetched within 5 s").all(), \
+        lost["message"].tolist()
     assert elapsed < 60, elapsed  # killed at 4 s, noticed 5 s later (plus polling and closing)
     done = table[table["status"] == "ok"]
     for _, row in done.iterrows():
