@@ -14,21 +14,17 @@ SCHEDULER_CALL_TIMEOUT = 5.0
 
 
 def _bounded(fn, *args):
-    """Calls fn(*args) in a daemon thread and waits at most SCHEDULER_CALL_TIMEOUT seconds: True
-    if it returned, False if it raised or is still waiting (then it is left behind)."""
-    outcome = []
-
+    """Calls fn(*args) in a daemon thread and waits for it at most SCHEDULER_CALL_TIMEOUT seconds
+    (a call still waiting then is left behind; an error is the lost scheduler's, ignored)."""
     def call():
         try:
             fn(*args)
-            outcome.append(True)
         except Exception:  # noqa: BLE001 -- a lost scheduler: the caller goes on without it
-            outcome.append(False)
+            pass
 
     t = threading.Thread(target=call, daemon=True, name="mbdae-sweep-dask-call")
     t.start()
     t.join(SCHEDULER_CALL_TIMEOUT)
-    return bool(outcome and outcome[0])
 
 
 class Threads:
