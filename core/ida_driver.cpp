@@ -6,6 +6,7 @@
 #include <exception>
 #include <cstdlib>
 #include <ctime>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <utility>
@@ -331,6 +332,17 @@ void finish_past_end(IdaRun& r, int flag, double tret) {
   if (r.stats.ok && interpolate(r, r.o->t1, 0, r.y) && interpolate(r, r.o->t1, 1, r.yp)) r.t = r.o->t1;
 }
 
+// The smallest step IDA may take from t: kMinStepUlps units in the last place of t. A step
+// below it no longer resolves t (at 3e-19 s near t = 0.72 s, t + h == t), so a run whose steps
+// collapse there fails at once with IDA's own message instead of crawling to the step budget
+// (A02 with N = 40 at its singular configuration: 110000 steps and 2.5 min before; docs/errors.md).
+constexpr double kMinStepUlps = 16;
+
+void limit_step_from(IdaRun& r, double tt) {
+  check(IDASetMinStep(r.mem, kMinStepUlps * std::numeric_limits<double>::epsilon() * std::fabs(tt)),
+        "IDASetMinStep");
+}
+
 // The state IDA returns at a root is interpolated, and the interpolated velocities are not
 // error-controlled at index 3. Step back to the last accepted step and integrate again with the
 // root time as stop time, so that the state at the root is a converged step. False: the run ends.
@@ -359,6 +371,7 @@ bool step_onto_root(IdaRun& r, double t_root) {
   int flag = IDA_SUCCESS;
   double tret = r.t;
   while (r.t < t_root && !r.stop_requested && r.stats.ok) {
+    limit_step_from(r, r.t);
     flag = IDASolve(r.mem, t_root, &tret, r.y, r.yp, IDA_ONE_STEP);
     if (flag < 0 || !finite(r, data(r.y), tret, "")) break;
     r.t = tret;
@@ -424,6 +437,7 @@ bool restart(IdaRun& r, const int* roots) {
 bool advance(IdaRun& r) {
   const IdaOptions& o = *r.o;
   double tret = r.t;
+  limit_step_from(r, r.t);
   const int flag = IDASolve(r.mem, o.t1, &tret, r.y, r.yp, IDA_ONE_STEP);
   if (flag < 0) {
     if (r.sens_on && drop_sensitivities(r, flag)) return true;

@@ -109,8 +109,9 @@ void expect_degraded_choice(const Result& r, const std::string& formulation) {
 // `ok` with a wrong one. Measured: index3 fails at t = 2.25 s with the diagnosis (with its
 // position test per unit of the span at c = 5, not kept at rtol 1e-6, it stepped over the quarter
 // turns and ended `ok` within 3.6 rtol), index2-ggl fails at the first one (0.2495 s, s_min /
-// s_max 3.8e-4: the nearly singular case of cases/run/failure_diagnosis.h), index1 and penalty
-// stop at the watch on the equations set aside.
+// s_max 3.8e-4: the nearly singular case of cases/run/failure_diagnosis.h), penalty stops at the
+// watch on the equations set aside, index1 either there or (since IDA's smallest step is 16 ulps
+// of t, core/ida_driver.cpp) when its steps collapse at 0.25 s, with the degraded-choice diagnosis.
 TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
   Scene scene = load_turning_case(kTurntableFourBar);
   scene.redundant_constraints = "remove_world";
@@ -133,8 +134,8 @@ TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
   for (const char* f : {"index1", "penalty"}) {
     opt.formulation = f;
     const Result r = run(scene, opt);
+    if (r.message.find("no longer hold at t = 0.25") == std::string::npos) expect_degraded_choice(r, f);
     EXPECT_EQ(r.status, "integration_failed") << f;
-    EXPECT_NE(r.message.find("no longer hold at t = 0.25"), std::string::npos) << f << ": " << r.message;
     EXPECT_EQ(r.rows(), 25u) << f;  // t = 0 ... 0.24; the sample at 0.25 is not written
   }
 }
