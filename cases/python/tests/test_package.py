@@ -92,15 +92,20 @@ def test_output_columns_and_notebook_views():
 
 
 def test_cpu_seconds_is_the_solving_threads_own():
-    """Two runs at once in two threads: each reports about its own CPU time, not the process's
-    (which counts both, plus the spinning main thread)."""
+    """Two runs at once in two threads while the main thread spins: each reports its own
+    thread's CPU time, a share of the process's CPU over that time (which counts both runs and
+    the spinning thread), not the process's. Compared with the process clock of the same
+    interval, not with a run alone: on a loaded machine the runs' own clocks grow with cache
+    sharing (1.8 times a run alone was seen under ctest -j2), their share does not."""
+    import time
     scene = mbdae.load(STEP)
     alone = min(scene.run().cpu_seconds() for _ in range(2))
-    results, stop = [None, None], threading.Event()
+    results = [None, None]
 
     def work(k):
         results[k] = scene.run()
     threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    process_before = time.process_time()
     for t in threads:
         t.start()
     x = 0
@@ -108,10 +113,14 @@ def test_cpu_seconds_is_the_solving_threads_own():
         x += 1
     for t in threads:
         t.join()
-    for r in results:
-        # Process CPU would be >= 2 x alone (two runs, the spinning thread besides); a run's own
-        # thread clock stays near `alone` (cache sharing and frequency changes: within 1.6 x).
-        assert 0.5 * alone < r.cpu_seconds() < 1.6 * alone, (r.cpu_seconds(), alone)
+    process = time.process_time() - process_before
+    own = [r.cpu_seconds() for r in results]
+    # The process clock counts both runs and the spinning thread: a run's own clock is at most
+    # a little over half of it (the two runs alike, the spinning thread besides), where the
+    # process's would be all of it.
+    for c in own:
+        assert 0.5 * alone < c < 0.6 * process, (own, process, alone)
+    assert sum(own) < 0.95 * process, (own, process)
 
 
 def test_imported_from_the_install_under_test():
