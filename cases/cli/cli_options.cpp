@@ -12,13 +12,10 @@
 namespace mbdae {
 namespace {
 
-// A number as the scene loader reads one: all of the text, finite.
+// A number as the scene loader reads one (number_error), the message naming the option.
 std::string read_number(const std::string& option, const std::string& text, double& v) {
-  char* end = nullptr;
-  v = std::strtod(text.c_str(), &end);
-  if (text.empty() || !end || *end != '\0') return option + ": expected a number, got '" + text + "'";
-  if (!std::isfinite(v)) return option + ": '" + text + "' is not a finite number";
-  return "";
+  const std::string why = number_error(text, v);
+  return why.empty() ? "" : option + ": " + why;
 }
 
 std::string read_option(const std::vector<std::string>& args, size_t& i, CommandLine& cl) {

@@ -12,10 +12,12 @@ std::string format_number(double x) {
   return os.str();
 }
 
-bool parse_number(const std::string& text, double& v) {
+std::string number_error(const std::string& text, double& v) {
   char* end = nullptr;
   v = std::strtod(text.c_str(), &end);
-  return !text.empty() && end && *end == '\0' && std::isfinite(v);
+  if (text.empty() || !end || *end != '\0') return "expected a number, got '" + text + "'";
+  if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
+  return "";
 }
 
 std::string rtol_range_error(double rtol) {

@@ -10,8 +10,10 @@ namespace mbdae {
 constexpr double kMaxOutputRows = 1e8;  // output_step may not ask for more rows than this
 
 std::string format_number(double x);  // as in messages: shortest of %g-like text (1e-300, 0.5)
-// A number as the scene loader reads one: all of `text`, finite. False otherwise.
-bool parse_number(const std::string& text, double& v);
+// A number as the scene loader reads one: all of `text`, finite. The message for text that is
+// not one ("expected a number, got 'x'", "'x' is not a finite number"), "" if it is.
+std::string number_error(const std::string& text, double& v);
+inline bool parse_number(const std::string& text, double& v) { return number_error(text, v).empty(); }
 std::string rtol_range_error(double rtol);
 std::string atol_range_error(double atol);
 // Positive, and at most kMaxOutputRows samples over [t0, t_end] (a span that is not valid is
