@@ -87,7 +87,9 @@ class Result:
         """The sensitivities relative to the parameters' values and the sensors' scales:
         (p / max|y|) dy/dp, max|y| each sensor's largest magnitude over the run (a pointwise
         (p / y) dy/dp is unbounded where y crosses zero). A DataFrame like `sensitivities`; a
-        sensor that is zero throughout gets no column. None without sensitivities."""
+        sensor that is zero throughout gets no column. None without sensitivities. The rule of
+        the CLI's sensitivities_normalized.csv (cases/run/sensitivities.cpp), kept alike by
+        test_api.py::test_normalized_sensitivities_are_the_clis."""
         table = self.sensitivities
         if table is None:
             return None

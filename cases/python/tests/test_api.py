@@ -244,3 +244,23 @@ def test_run_with_animation_true_leaves_no_temporary_folder(tmp_path, monkeypatc
                        env={**os.environ, "TMPDIR": str(tmp_path)})
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip().startswith(str(tmp_path)) and not Path(p.stdout.strip()).exists()
+
+
+def test_normalized_sensitivities_are_the_clis(tmp_path):
+    """Result.normalized_sensitivities() (Python) and sensitivities_normalized.csv (the CLI's
+    --normalized-sensitivities, cases/run/sensitivities.cpp) apply one rule: the same numbers, to
+    the CSV's digits, on Dynamics I with the tyre stiffness and the damping."""
+    import pandas as pd
+    params = ["forces.tyre.stiffness", "forces.suspension.damping"]
+    args = ["--normalized-sensitivities"]
+    for p in params:
+        args += ["--sensitivity", p]
+    code, err = cli_run(STEP, tmp_path, *args)
+    assert code == 0, err
+    csv = pd.read_csv(tmp_path / "sensitivities_normalized.csv")
+    table = mbdae.load(STEP).run(sensitivities=params).normalized_sensitivities()
+    assert len(table.columns) == len(csv.columns) - 1 > 0
+    for (sensor, param), column in zip(table.columns, csv.columns[1:]):
+        assert column == f"d({sensor})/d({param})*p/max|{sensor}|", column
+        x, y = table[(sensor, param)].to_numpy(), csv[column].to_numpy()
+        assert np.allclose(x, y, rtol=1e-9, atol=1e-12 * np.abs(y).max()), column
