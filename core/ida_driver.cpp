@@ -433,6 +433,20 @@ bool restart(IdaRun& r, const int* roots) {
   return true;
 }
 
+// After a step whose Newton matrix was factored afresh, the caller's check of that state
+// (IdaOptions::after_fresh_factorization). False: the run failed there.
+bool newton_matrix_fine(IdaRun& r, double tret) {
+  if (!r.o->after_fresh_factorization) return true;
+  const long fresh = newton_linear_solver_fresh_factorizations(r.ls);
+  if (fresh == r.fresh_seen) return true;
+  r.fresh_seen = fresh;
+  if (r.o->after_fresh_factorization(tret, data(r.y))) return true;
+  std::ostringstream os;
+  os << "the Newton matrix's pivots degraded (factored afresh) at t = " << tret;
+  fail(r, "integration_failed", os.str(), tret);
+  return false;
+}
+
 // One IDA step and what follows it (samples, an event, a breakpoint). False: the run ends.
 bool advance(IdaRun& r) {
   const IdaOptions& o = *r.o;
@@ -445,6 +459,7 @@ bool advance(IdaRun& r) {
     return false;
   }
   if (!finite(r, data(r.y), tret, "")) return false;
+  if (!newton_matrix_fine(r, tret)) return false;
   if (tret > o.t1) {
     finish_past_end(r, flag, tret);
     return false;

@@ -40,6 +40,10 @@ struct IdaOptions {
   // until two tests at the noise floor are revisited (docs/performance.md, "The reduced Newton
   // solve").
   bool reduced_newton = false;
+  // Called after an accepted step during which the Newton matrix was factored afresh (its reused
+  // pivots had degraded: the matrix nearly singular), with that step's t and y; false ends the
+  // run there as integration_failed, for the caller to diagnose. Null: not asked.
+  std::function<bool(double, const double*)> after_fresh_factorization;
   // Forward sensitivities of the solution (IDAS, core/sensitivity_problem.h), or null. Each
   // sample's (t, y, y', s_i, s_i') go to sensitivity_output right after the sample went to
   // `output` (y' null where `output` gets none).

@@ -86,6 +86,7 @@ struct IdaRun {
   double t = 0, t_prev = 0;  // the current time and that of the last accepted step
   std::vector<double> y_prev, yp_prev;
   IdaStats stats;
+  long fresh_seen = 0;    // fresh Newton-matrix factorizations already passed to after_fresh_factorization
   long watch_steps = 0;  // steps since watch_t (the step budget, IdaOptions::max_total_steps)
   double watch_t = 0;
   int watch_strikes = 0;  // windows in a row whose rate projects more than the budget

@@ -19,6 +19,7 @@
 #include "formulation/initial_velocities.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
+#include "formulation/singularity.h"
 #include "formulation/kinematic_sensitivities.h"
 #include "formulation/twin_sensitivities.h"
 
@@ -478,6 +479,14 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
     return false;
   }
   SetAsideWatch watch(c, tol, io.rtol);
+  // With equations set aside, a Newton matrix whose pivots degraded may be the kept equations
+  // going singular where the mechanism's are not: a degraded choice, which index3 can step
+  // across with a wrong motion (TurningLoops, the world choice). The run stops there and
+  // report_failure tells the choice's failure.
+  if (c.all_equations)
+    io.after_fresh_factorization = [&](double t, const double* yy) {
+      return !check_equation_choice(*c.all_equations, sys, yy, dae->input_time(t), kNearlySingularRatio).degraded;
+    };
   Sampler sampler(c, step, *dae, watch, io.output_step);
   const StepSensitivities sens = attach_sensitivities(c, step, *dae, *f, fp, tol, io, sampler, js);
   const TwinSensitivities* ts = sens.integrated.get();

@@ -162,6 +162,45 @@ TEST(IdaDriver, OutputErrorStopsTheRun) {
   EXPECT_DOUBLE_EQ(st.t_reached, 0.5);
 }
 
+// IdaOptions::after_fresh_factorization sees the step after each fresh factorization (the
+// decay's only one, the first Newton matrix) with that step's state; false ends the run there as
+// integration_failed, the samples before it kept.
+TEST(IdaDriver, AFreshFactorizationCheckCanEndTheRun) {
+  DecayProblem p;
+  std::vector<Sample> s;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.output_step = 0.1;
+  std::vector<double> seen;
+  o.after_fresh_factorization = [&](double t, const double* yy) {
+    seen.push_back(t);
+    EXPECT_NEAR(yy[0], p.exact(t), 1e-6);
+    return true;
+  };
+  IdaStats st = integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
+    s.push_back({t, yy[0], yy[1]});
+    return true;
+  });
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(seen.size(), 1u);  // one fresh factorization: the rest refactor on its pivots
+  EXPECT_GT(seen[0], 0.0);
+  EXPECT_EQ(s.size(), 21u);
+  y = {1.0, 2.0};
+  yp = {-1.0, -2.0};
+  s.clear();
+  o.after_fresh_factorization = [](double, const double*) { return false; };
+  st = integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
+    s.push_back({t, yy[0], yy[1]});
+    return true;
+  });
+  ASSERT_FALSE(st.ok);
+  EXPECT_EQ(st.status, "integration_failed");
+  EXPECT_NE(st.message.find("pivots degraded"), std::string::npos) << st.message;
+  EXPECT_EQ(st.t_reached, seen[0]);
+  EXPECT_EQ(s.size(), 1u);  // the initial state only: the step's own samples are not written
+}
+
 // A setting IDA refuses (its maximum order must be 1 to 5) is an internal error naming the call,
 // not a run that goes on with IDA's default (every SUNDIALS flag goes through one check).
 TEST(IdaDriver, RefusedSettingNamesTheSundialsCall) {

@@ -106,12 +106,13 @@ void expect_degraded_choice(const Result& r, const std::string& formulation) {
 
 // With the world choice the kept equations go singular at every quarter turn. A run either stops
 // there with the diagnosis or steps over it with the right motion (within the promise), never
-// `ok` with a wrong one. Measured: index3 fails at t = 2.25 s with the diagnosis (with its
-// position test per unit of the span at c = 5, not kept at rtol 1e-6, it stepped over the quarter
-// turns and ended `ok` within 3.6 rtol), index2-ggl fails at the first one (0.2495 s, s_min /
-// s_max 3.8e-4: the nearly singular case of cases/run/failure_diagnosis.h), penalty stops at the
-// watch on the equations set aside, index1 either there or (since IDA's smallest step is 16 ulps
-// of t, core/ida_driver.cpp) when its steps collapse at 0.25 s, with the degraded-choice diagnosis.
+// `ok` with a wrong one. Measured: index3 fails at the first one (0.2485 s: the check after a
+// fresh factorization, cases/run/integration_stage.cpp; before, it stepped over the quarter turns
+// until 2.25 s, or to the end with a wrong motion at other rtols and orderings), index2-ggl too
+// (0.2495 s, s_min / s_max 3.8e-4: the nearly singular case of cases/run/failure_diagnosis.h),
+// penalty stops at the watch on the equations set aside, index1 either there or (since IDA's
+// smallest step is 16 ulps of t, core/ida_driver.cpp) when its steps collapse at 0.25 s, with the
+// degraded-choice diagnosis.
 TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
   Scene scene = load_turning_case(kTurntableFourBar);
   scene.redundant_constraints = "remove_world";
