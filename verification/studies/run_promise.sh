@@ -30,6 +30,10 @@ tp="$build/verification/studies/tolerance_promise"
 # A05: its reference at rtol 1e-13 (at 1e-11 its check differs by 2e-6 of the scales).
 "$tp" --scene verification/iftomm/scenes/A05_stiff_flyball_governor.yaml --label "A05" --formulations "$forms" \
   --tols "$tols" --ref-rtol 1e-13 --csv "$tmp/5.csv"
+# A governor driven by a speed-dependent motor torque (A05's mechanism and a load reading omega);
+# its index2-ggl reference at rtol 1e-13, as A05's.
+"$tp" --scene verification/studies/promise/governor_motor.yaml --label "governor with motor" --formulations "$forms" \
+  --tols "$tols" --ref-rtol 1e-13 --csv "$tmp/7.csv"
 # The spinning top (issue 21) against its Euler equations (scipy DOP853 at rtol 1e-13; the rtol
 # 1e-11 solution agrees to 1.6e-11 and 1.2e-11 of the scales).
 pr="$here/promise"
@@ -38,6 +42,6 @@ echo "case" > "$tmp/6.csv"
 /usr/bin/python3 "$pr/promise_study.py" --mbdae "$build/mbdae" --scene "$pr/spinning_top.yaml" --ref "$tmp/top_ref.csv" \
   --pos tip_x,tip_y,tip_z --vel tip_vx,tip_vy,tip_vz --label "spinning top" --formulations "$forms" --tols "$tols" \
   --ref-check 1.6e-11,1.2e-11 --csv "$tmp/6.csv" > /dev/null
-{ head -1 "$tmp/1.csv"; for f in "$tmp"/[0-6].csv; do tail -n +2 "$f"; done; } > "$out/promise.csv"
+{ head -1 "$tmp/1.csv"; for f in "$tmp"/[0-7].csv; do tail -n +2 "$f"; done; } > "$out/promise.csv"
 /usr/bin/python3 "$here/plot_promise.py" "$out/promise.csv" "$out/promise.png"
 echo "wrote $out/promise.csv and $out/promise.png"
