@@ -47,7 +47,8 @@ SingularityReport diagnose_singularity(const System& sys, const double* q, doubl
 // set aside: `all` is the system with every equation (as built), `kept` the one integrated. At q
 // the equations of `all` are chosen again (choose_independent_equations); the choice has
 // degraded where the kept equations are (nearly) singular, s_min / s_max below `singular_ratio`,
-// while the new choice sets aside as many equations and is not.
+// while the new choice sets aside as many equations and is not (made at looser rank tolerances
+// where the default one sets aside fewer: a row nearly dependent near that instant).
 struct EquationChoiceCheck {
   bool degraded = false;
   double kept_ratio = 0;      // s_min / s_max of the kept equations' row-normalized Jacobian

@@ -82,6 +82,27 @@ TEST(EquationChoice, DegradedChoiceIsToldFromTheMechanism) {
   EXPECT_GT(b.kept_ratio, 1e-2);
 }
 
+// Close to the quarter turn, where the world choice is nearly singular, and off the constraints by
+// 1e-10 (an integrated state), the new choice still sets aside three equations and is well
+// conditioned: where the rank decision at the default tolerance keeps a nearly dependent row,
+// check_equation_choice chooses again at looser tolerances.
+TEST(EquationChoice, DegradedChoiceIsToldCloseToTheQuarterTurn) {
+  Turntable f = turntable();
+  const System world = without_redundant_constraints(f.all, find_redundant_constraints(f.all, f.q.data(), 0.0));
+  AugmentedSolver projector(f.all);
+  for (const double before : {3e-3, 3e-4, 3e-5, 3e-6, 3e-7, 3e-8}) {
+    const double t = 0.25 - before;
+    ASSERT_TRUE(projector.positions(f.q.data(), t, 1e-12, 100, 1e-10).converged) << t;
+    std::vector<double> q = f.q;  // off the constraints by 1e-10, as an integrated state can be
+    for (size_t i = 0; i < q.size(); ++i) q[i] += 1e-10 * std::sin(1.0 + 7.0 * i);
+    const EquationChoiceCheck w = check_equation_choice(f.all, world, q.data(), t, 1e-2);
+    EXPECT_TRUE(w.degraded) << t;
+    EXPECT_EQ(w.set_aside_again, 3) << t;
+    EXPECT_GT(w.rechosen_ratio, 1e-2) << t;
+    EXPECT_LT(w.kept_ratio, 1e-2) << t;
+  }
+}
+
 // The parallelogram four-bar folding flat is singular whatever equations are kept.
 TEST(EquationChoice, FoldingFourBarIsASingularConfiguration) {
   System all = build_system(testing::four_bar(0.5));

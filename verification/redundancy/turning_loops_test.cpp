@@ -110,9 +110,8 @@ void expect_degraded_choice(const Result& r, const std::string& formulation) {
 // fresh factorization, cases/run/integration_stage.cpp; before, it stepped over the quarter turns
 // until 2.25 s, or to the end with a wrong motion at other rtols and orderings), index2-ggl too
 // (0.2495 s, s_min / s_max 3.8e-4: the nearly singular case of cases/run/failure_diagnosis.h),
-// penalty stops at the watch on the equations set aside, index1 either there or (since IDA's
-// smallest step is 16 ulps of t, core/ida_driver.cpp) when its steps collapse at 0.25 s, with the
-// degraded-choice diagnosis.
+// index1 and penalty just before the quarter turn, with the same diagnosis (the same check), or
+// at the watch on the equations set aside (before that check).
 TEST(TurningLoops, WorldChoiceIsDiagnosedNeverOkWithAWrongMotion) {
   Scene scene = load_turning_case(kTurntableFourBar);
   scene.redundant_constraints = "remove_world";
