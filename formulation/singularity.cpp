@@ -140,9 +140,7 @@ double ratio(const SingularityReport& r) {
   if (r.rank < r.equations) return 0.0;
   return r.largest_singular_value > 0 ? r.smallest_singular_value / r.largest_singular_value : 0.0;
 }
-}  // namespace
-
-namespace {
+// The loosest rank tolerance at which check_equation_choice chooses the equations again.
 constexpr double kLoosestRankTolerance = 1e-3;
 }  // namespace
 
