@@ -24,13 +24,20 @@ struct Sample {
   double t, y1, y2;
 };
 
-IdaStats run(DecayProblem& p, std::vector<Sample>& samples, std::vector<double>& y) {
+// The decay over [0, 2] at rtol 1e-10, sampled every 0.1.
+IdaOptions decay_options() {
   IdaOptions o;
   o.t0 = 0;
   o.t1 = 2;
   o.rtol = 1e-10;
   o.atol = 1e-12;
   o.output_step = 0.1;
+  return o;
+}
+
+// Runs the decay from its initial values with options o, each sample appended to `samples`.
+IdaStats run(DecayProblem& p, std::vector<Sample>& samples, std::vector<double>& y,
+             const IdaOptions& o = decay_options()) {
   y = {1.0, 2.0};
   std::vector<double> yp = {-1.0, -2.0};
   return integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
@@ -168,32 +175,22 @@ TEST(IdaDriver, OutputErrorStopsTheRun) {
 TEST(IdaDriver, AFreshFactorizationCheckCanEndTheRun) {
   DecayProblem p;
   std::vector<Sample> s;
-  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
-  IdaOptions o;
-  o.t1 = 2;
-  o.output_step = 0.1;
+  std::vector<double> y;
+  IdaOptions o = decay_options();
   std::vector<double> seen;
   o.after_fresh_factorization = [&](double t, const double* yy) {
     seen.push_back(t);
     EXPECT_NEAR(yy[0], p.exact(t), 1e-6);
     return true;
   };
-  IdaStats st = integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
-    s.push_back({t, yy[0], yy[1]});
-    return true;
-  });
+  IdaStats st = run(p, s, y, o);
   ASSERT_TRUE(st.ok) << st.message;
   ASSERT_EQ(seen.size(), 1u);  // one fresh factorization: the rest refactor on its pivots
   EXPECT_GT(seen[0], 0.0);
   EXPECT_EQ(s.size(), 21u);
-  y = {1.0, 2.0};
-  yp = {-1.0, -2.0};
   s.clear();
   o.after_fresh_factorization = [](double, const double*) { return false; };
-  st = integrate(p, o, y, yp, [&](double t, const double* yy, const double*) {
-    s.push_back({t, yy[0], yy[1]});
-    return true;
-  });
+  st = run(p, s, y, o);
   ASSERT_FALSE(st.ok);
   EXPECT_EQ(st.status, "integration_failed");
   EXPECT_NE(st.message.find("pivots degraded"), std::string::npos) << st.message;
