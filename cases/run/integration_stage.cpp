@@ -423,7 +423,7 @@ json statistics_json(const IdaStats& st, const MultibodyDae& dae, const Sampler&
 
 // The last configuration reached and, if the constraint Jacobian is singular there, why the run
 // cannot go on (a drive past the mechanism's travel, a dead centre): after a failed step, and
-// after a step budget spent in ever smaller steps (index1 at rtol 1e-10 at A02's fold).
+// after a step budget spent in ever smaller steps.
 void report_failure(RunContext& c, const IdaStats& st, MultibodyDae& dae, const std::vector<double>& y, json& js) {
   std::string message = st.message;
   if (st.status == "integration_failed" || st.status == "step_limit") {
