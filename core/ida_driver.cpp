@@ -343,54 +343,6 @@ void limit_step_from(IdaRun& r, double tt) {
         "IDASetMinStep");
 }
 
-// The state IDA returns at a root is interpolated, and the interpolated velocities are not
-// error-controlled at index 3. Step back to the last accepted step and integrate again with the
-// root time as stop time, so that the state at the root is a converged step. False: the run ends.
-bool step_onto_root(IdaRun& r, double t_root) {
-  const double h_default = r.ud.h_initial;
-  choose_initial_step(r, r.t_prev);
-  r.ud.h_initial = std::min(r.ud.h_initial, t_root - r.t_prev);
-  if (r.ud.h_initial > 1e-12 * std::max(1.0, std::fabs(t_root))) {
-    // The sensitivities at the last accepted step, from IDAS's interpolant (it passes through
-    // that step's solution), before IDA's history is reset.
-    if (r.sens_on && !sensitivities_at_last_step(r)) {
-      fail(r, "integration_failed", "the sensitivities at t = " + std::to_string(r.t_prev) + " cannot be had", r.t_prev);
-      return false;
-    }
-    r.s_at_prev = r.sens_on;
-    std::memcpy(data(r.y), r.y_prev.data(), r.n * sizeof(double));
-    std::memcpy(data(r.yp), r.yp_prev.data(), r.n * sizeof(double));
-    check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
-    reinit(r, r.t_prev);
-    check(IDARootInit(r.mem, 0, nullptr), "IDARootInit");
-    check(IDASetStopTime(r.mem, t_root), "IDASetStopTime");
-    r.t = r.t_prev;
-  } else {
-    r.t = t_root;  // the root is at the last step: its state is that step's
-  }
-  int flag = IDA_SUCCESS;
-  double tret = r.t;
-  while (r.t < t_root && !r.stop_requested && r.stats.ok) {
-    limit_step_from(r, r.t);
-    flag = IDASolve(r.mem, t_root, &tret, r.y, r.yp, IDA_ONE_STEP);
-    if (flag < 0 || !finite(r, data(r.y), tret, "")) break;
-    r.t = tret;
-    r.problem->after_step(r.t, data(r.y));
-    emit_until(r, r.t);
-  }
-  check(IDARootInit(r.mem, r.nsw, root_fn), "IDARootInit");
-  r.ud.h_initial = h_default;
-  check(IDASetInitStep(r.mem, r.ud.h_initial), "IDASetInitStep");
-  if (flag < 0 && r.sens_on && r.stats.ok) {  // the sensitivities' failure: on from t_prev (advance)
-    r.go_on = drop_sensitivities(r, flag);
-    return false;
-  }
-  if (flag < 0) ida_failure(r, flag);
-  if (!r.stats.ok) return false;
-  r.stats.event_times.push_back(r.t);
-  return true;
-}
-
 // IDA anew at r.t from (y, y') (after a restart or a retry): the first step chosen again, then on
 // to the next stop.
 void start_again(IdaRun& r) {
@@ -472,14 +424,16 @@ bool advance(IdaRun& r) {
     check(IDAGetRootInfo(r.mem, r.roots.data()), "IDAGetRootInfo");
     // A root that changes no mode (a switching function grazing zero) needs no restart.
     if (!r.problem->changes_mode(tret, data(r.y), r.roots.data())) return true;
-    if (!step_onto_root(r, tret)) return std::exchange(r.go_on, false);
+  }
+  // At a root the state is IDA's interpolant there, which restart() makes consistent.
+  r.t = tret;
+  r.problem->after_step(r.t, data(r.y));
+  emit_until(r, r.t);
+  if (!r.stats.ok) return false;
+  if (is_root) {
+    r.stats.event_times.push_back(r.t);
   } else {
-    r.t = tret;
-    r.problem->after_step(r.t, data(r.y));
-    emit_until(r, r.t);
-    if (!r.stats.ok) return false;
     keep_step(r);
-    r.s_at_prev = false;
     if (flag != IDA_ROOT_RETURN && flag != IDA_TSTOP_RETURN) return true;
     if (r.t >= o.t1) return false;
     r.stats.breakpoint_times.push_back(r.t);

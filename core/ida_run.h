@@ -94,8 +94,6 @@ struct IdaRun {
   // between IDAS calls) and of a sample's interpolated ones; their data pointers.
   int ns = 0;
   bool sens_on = false;  // false once IDA failed with them (drop_sensitivities)
-  bool s_at_prev = false;  // r.s, r.sp hold the sensitivities at t_prev (step_onto_root set them)
-  bool go_on = false;      // step_onto_root failed with the sensitivities, and the run goes on
   N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
   std::vector<double*> s_data, sp_data, ss_data, sps_data;
   std::vector<double> pbar;

@@ -105,7 +105,6 @@ bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp) 
 // there, or, before any step since the last (re)initialization, the values it was given (they
 // are still in r.s, r.sp). False (the run not failed) if IDAS cannot give them.
 bool sensitivities_at_last_step(IdaRun& r) {
-  if (r.s_at_prev) return true;
   long steps = 0;
   if (IDAGetNumSteps(r.mem, &steps) != IDA_SUCCESS) return false;
   for (int i = 0; steps > 0 && i < r.ns; ++i)

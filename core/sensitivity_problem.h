@@ -29,7 +29,7 @@ class SensitivityProblem {
   // After IDA failed with the sensitivities: switch to a more robust (dearer) residual and return
   // true, the driver then retries from the last accepted step; false if there is none.
   virtual bool fall_back() { return false; }
-  // IDA starts anew (a restart, the re-integration onto an event's root, a retry): its first
+  // IDA starts anew (a restart at an event or a breakpoint, a retry): its first
   // steps are tiny.
   virtual void reinitialized() {}
   // Whether the sensitivities are in the local error test (else only in the Newton test).

@@ -208,8 +208,8 @@ void MultibodyDae::restart(double t, double* y, double* yp, const int* roots) {
   update_turns(sys_, y, y + nq_, t, state_.turns);
 }
 
-// The state at a root is a converged step onto the root time (core/ida_driver.cpp), which can lie
-// up to a local error on the other side of the switch: a wheel set free there while still a
+// The state at a root (IDA's interpolant at the root time, made consistent: core/ida_driver.cpp)
+// can lie up to a local error on the other side of the switch: a wheel set free there while still a
 // little below the ground would never see g cross zero again and would fall through the ground
 // (seen on dynamics II at rtol 1e-4). Where g disagrees with its mode, the root function is
 // shifted by g's value here, so that it starts at zero and the next crossing is found; the

@@ -206,8 +206,8 @@ TEST(Suspension, GroundStepConvergesWithTheTolerance) {
 }
 
 // Dynamics II at a loose tolerance (index2-ggl, rtol 1e-4, the model's default atol). The state
-// at a tyre-contact event is a converged step onto the root time and can lie a local error on the
-// other side of the switch: before the root functions were shifted there
+// at a tyre-contact event (made consistent at the root time) can lie a local error on the other
+// side of the switch: before the root functions were shifted there
 // (MultibodyDae::set_switch_offsets) the wheel was set free 5.5e-6 m below the ground at 14.66 s,
 // never saw the contact function cross zero again, and fell 140 m with status ok. Compared with
 // the scene's own run (index3, rtol 1e-7): measured 7.2e-4 m with the per-step error test,
