@@ -34,6 +34,14 @@ const std::vector<Formulation>& formulation_registry() {
                                             BaumgarteParameters{p.baumgarte_alpha, p.baumgarte_beta}, false, 0.0);
        },
        true},
+      {"index1-no-handover",
+       "index1 at every rtol, also below 1e-9 where index1 runs as index2-ggl (formulation/index1_dae.h)", false,
+       false,
+       [](const System& s, const FormulationParameters& p) -> std::unique_ptr<MultibodyDae> {
+         return std::make_unique<Index1Dae>(s, p.constraint_scale,
+                                            BaumgarteParameters{p.baumgarte_alpha, p.baumgarte_beta}, false, 0.0);
+       },
+       true},
       {"penalty", "index 1 with a penalty term and Baumgarte stabilization (formulation/index1_dae.h)", false, true,
        [](const System& s, const FormulationParameters& p) -> std::unique_ptr<MultibodyDae> {
          return std::make_unique<Index1Dae>(s, p.constraint_scale,
@@ -58,8 +66,12 @@ std::string formulation_names(bool last_or) {
   return s;
 }
 
+double handover_rtol(const std::string& name) {
+  return name == "index3" ? kIndex3HandoverRtol : name == "index1" ? kIndex1HandoverRtol : 0.0;
+}
+
 std::string formulation_at(const std::string& name, double rtol) {
-  return name == "index3" && rtol < kIndex3HandoverRtol ? "index2-ggl" : name;
+  return rtol < handover_rtol(name) ? "index2-ggl" : name;
 }
 
 }  // namespace mbdae

@@ -56,6 +56,13 @@ std::string formulation_names(bool last_or = false);
 // below their rounding there, and its error stops falling with rtol (docs/formulation.md, "index3
 // hands over to index2-ggl below rtol 1e-6"). "index3-no-handover" is index3 at every rtol.
 constexpr double kIndex3HandoverRtol = 1e-6;
+// Below this rtol "index1" runs as index2-ggl: index1's velocities carry the positions' rounding
+// per step, and the floor its error test keeps above that noise lets the steps' errors add up past
+// 10 rtol at rtol 1e-10 (docs/formulation.md, "index1 hands over to index2-ggl below rtol 1e-9").
+// "index1-no-handover" is index1 at every rtol.
+constexpr double kIndex1HandoverRtol = 1e-9;
+// The rtol below which a dynamics step asked for `name` runs as index2-ggl; 0 if it never does.
+double handover_rtol(const std::string& name);
 // The formulation that integrates when `name` is asked at `rtol`.
 std::string formulation_at(const std::string& name, double rtol);
 

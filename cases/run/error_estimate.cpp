@@ -222,14 +222,15 @@ RunOptions comparison_options(const Scene& scene, const RunOptions& options, dou
   const double k = rtol / factor >= kMinRtol || factor * rtol > kMaxRtol ? 1.0 / factor : factor;
   c.rtol = std::max(kMinRtol, k * rtol);
   c.atol = options.atol > 0 ? k * options.atol : 0.0;
-  // The comparison integrates as the run does: an index3 run stays index3 where the comparison's
-  // tighter rtol would hand over to index2-ggl (run_stages.h), which costs 2 to 3 times index3's
-  // run on the suspension (docs/formulation.md, "index3 hands over").
-  const auto index3 = [&](const AnalysisStep& s) { return !integrates(s) || step_formulation(s, options) == "index3"; };
+  // The comparison integrates as the run does: an index3 (index1) run stays index3 (index1) where
+  // the comparison's tighter rtol would hand over to index2-ggl (run_stages.h), which costs 2 to 3
+  // times index3's run on the suspension (docs/formulation.md, "index3 hands over").
   const int last = last_integration(scene);
-  if (c.formulation == options.formulation && last >= 0 && std::all_of(scene.steps.begin(), scene.steps.end(), index3) &&
-      step_formulation(scene.steps[last], c) != "index3")
-    c.formulation = "index3-no-handover";
+  const std::string ran = last >= 0 ? step_formulation(scene.steps[last], options) : "";
+  const auto same = [&](const AnalysisStep& s) { return !integrates(s) || step_formulation(s, options) == ran; };
+  if (c.formulation == options.formulation && handover_rtol(ran) > 0 &&
+      std::all_of(scene.steps.begin(), scene.steps.end(), same) && step_formulation(scene.steps[last], c) != ran)
+    c.formulation = ran + "-no-handover";
   return c;
 }
 
@@ -257,8 +258,9 @@ ErrorEstimate compare_runs(const Scene& scene, const RunOptions& options, const 
   other.rtol = e.rtol;
   other.atol = e.atol;
   // Another formulation whose error keeps falling with rtol (index3 would hand over, or sit at
-  // its floor: an upper bound 1e4 times the error).
-  other.formulation = e.formulation == "index2-ggl" ? "index1" : "index2-ggl";
+  // its floor: an upper bound 1e4 times the error); index1 as itself (it would hand over to
+  // index2-ggl below rtol 1e-9).
+  other.formulation = e.formulation == "index2-ggl" ? "index1-no-handover" : "index2-ggl";
   const Result third = run(scene, other);
   e.method = "second_formulation";
   describe_comparison(third, e);

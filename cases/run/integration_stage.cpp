@@ -300,8 +300,9 @@ std::unique_ptr<KinematicSensitivities> kinematic_sensitivities(RunContext& c, c
 void note_rounding_floor(RunContext& c, const std::string& formulation, double rtol, double fraction, json& js) {
   if (!(fraction > 0.5)) return;
   const bool index3 = formulation.rfind("index3", 0) == 0;
-  // index3 itself hands over below rtol 1e-6: there a tighter rtol does buy accuracy.
+  // index3 and index1 themselves hand over (below rtol 1e-6 and 1e-9): there a tighter rtol does buy accuracy.
   const char* further = formulation == "index3" ? "; below rtol 1e-6 index3 runs as index2-ggl, whose error follows rtol further"
+                        : formulation == "index1" ? "; below rtol 1e-9 index1 runs as index2-ggl, whose error follows rtol further"
                         : index3               ? "; a tighter rtol buys steps, not accuracy; index2-ggl follows rtol further"
                                                : "; a tighter rtol buys steps, not accuracy";
   char buf[600];
@@ -315,15 +316,17 @@ void note_rounding_floor(RunContext& c, const std::string& formulation, double r
   if (c.options.verbose) std::fprintf(stderr, "mbdae: note: %s\n", buf);
 }
 
-// index3 asked below rtol 1e-6: the step records what was asked and why index2-ggl ran, in the
-// step and the summary's notes (on stderr unless quiet).
+// index3 asked below rtol 1e-6, index1 below 1e-9: the step records what was asked and why
+// index2-ggl ran, in the step and the summary's notes (on stderr unless quiet).
 void note_handover(RunContext& c, const std::string& asked, const std::string& used, double rtol, json& js) {
+  const char* why = asked == "index3" ? "index3's error test would ask for positions below their rounding and its "
+                                        "error would stop falling with rtol"
+                                      : "index1's error test would stop at the velocities' rounding per step and its "
+                                        "error would stop falling with rtol";
   char buf[500];
   std::snprintf(buf, sizeof buf,
-                "rtol %g: %s runs as %s below rtol %g, where index3's error test would ask for positions below "
-                "their rounding and its error would stop falling with rtol (docs/formulation.md); "
-                "index3-no-handover keeps index3",
-                rtol, asked.c_str(), used.c_str(), kIndex3HandoverRtol);
+                "rtol %g: %s runs as %s below rtol %g, where %s (docs/formulation.md); %s-no-handover keeps %s", rtol,
+                asked.c_str(), used.c_str(), handover_rtol(asked), why, asked.c_str(), asked.c_str());
   js["formulation_asked"] = asked;
   js["formulation_handover"] = buf;
   c.result.summary["notes"].push_back(buf);
@@ -333,7 +336,7 @@ void note_handover(RunContext& c, const std::string& asked, const std::string& u
 // The step's formulation: the run option's, else the step's. With sensitivities a scene's index3
 // step runs as index2-ggl, and says so (a formulation asked by name is refused before the run;
 // docs/sensitivities.md), except a kinematic step whose sensitivities need no integration.
-// A dynamics step's index3 below rtol 1e-6 runs as index2-ggl, and says so
+// A dynamics step's index3 below rtol 1e-6 (index1 below 1e-9) runs as index2-ggl, and says so
 // (formulation/formulation_registry.h), unless the step runs at the tolerances its scene fixes.
 std::string run_formulation(RunContext& c, const AnalysisStep& step, double rtol, json& js) {
   const std::string asked = !c.options.formulation.empty() ? c.options.formulation : step.formulation;

@@ -239,5 +239,25 @@ TEST(ErrorControlNotes, Index3HandsOverBelowOneMillionth) {
   EXPECT_EQ(r.summary["steps"].back()["formulation"], "index3");
 }
 
+// index1 hands over below rtol 1e-9, where its error stops at the velocities' rounding floor
+// (docs/formulation.md); index1-no-handover keeps index1.
+TEST(ErrorControlNotes, Index1HandsOverBelowOneBillionth) {
+  const Scene scene = load_scene(source(kFast));
+  auto step_of = [&](const char* formulation, double rtol) {
+    const Result r = run_with(scene, formulation, rtol);
+    return std::make_pair(r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array()));
+  };
+  const auto [tight, tight_notes] = step_of("index1", 1e-10);
+  EXPECT_EQ(tight["formulation"], "index2-ggl");
+  EXPECT_EQ(tight["formulation_asked"], "index1");
+  ASSERT_FALSE(tight_notes.empty());
+  EXPECT_NE(tight_notes[0].get<std::string>().find("index1 runs as index2-ggl below rtol 1e-09"), std::string::npos);
+  EXPECT_NE(tight_notes[0].get<std::string>().find("index1-no-handover keeps index1"), std::string::npos);
+  const auto [at, at_notes] = step_of("index1", 1e-9);
+  EXPECT_EQ(at["formulation"], "index1");
+  EXPECT_FALSE(at.contains("formulation_asked"));
+  EXPECT_EQ(step_of("index1-no-handover", 1e-10).first["formulation"], "index1-no-handover");
+}
+
 }  // namespace
 }  // namespace mbdae

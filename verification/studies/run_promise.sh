@@ -10,7 +10,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 build="${BUILD:-$root/build}"
-forms="${FORMULATIONS:-index3,index3-no-handover,index3-positions,index2-ggl,index1,penalty}"
+forms="${FORMULATIONS:-index3,index3-no-handover,index3-positions,index2-ggl,index1,index1-no-handover,penalty}"
 tols="${TOLS:-1e-2,1e-4,1e-6,1e-8,1e-10}"
 out="$root/docs/studies"
 tmp="$(mktemp -d)"

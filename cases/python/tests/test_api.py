@@ -59,6 +59,13 @@ def test_index3_handover_is_the_clis_and_says_so(tmp_path):
     assert kept.summary["steps"][-1]["formulation"] == "index3-no-handover"
     assert "formulation_asked" not in kept.summary["steps"][-1]
     assert "index3-no-handover" in mbdae.formulations()
+    # index1 likewise below rtol 1e-9; index1-no-handover keeps index1.
+    assert "index1-no-handover" in mbdae.formulations()
+    tight = mbdae.load(STEP).run(formulation="index1", rtol=3e-10, output_step=0.05)
+    assert (tight.summary["steps"][-1]["formulation"], tight.summary["steps"][-1]["formulation_asked"]) == \
+        ("index2-ggl", "index1")
+    own = mbdae.load(STEP).run(formulation="index1-no-handover", rtol=3e-10, output_step=0.05)
+    assert own.summary["steps"][-1]["formulation"] == "index1-no-handover"
 
 
 @needs_analysis_option
