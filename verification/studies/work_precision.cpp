@@ -269,7 +269,8 @@ Run run(const mbdae::Scene& scene, const std::string& formulation, double tol, d
       r.message = out.summary.value("message", "");
       if (step) {
         r.t_reached = step->value("t_reached", NAN);
-        // index3 below rtol 1e-6 runs as index2-ggl and says so (formulation_asked): not a warning.
+        // index3 below rtol 1e-6 and index1 below 1e-9 run as index2-ggl and say so
+        // (formulation_asked): not a warning.
         if (step->contains("formulation") && (*step)["formulation"] != formulation &&
             step->value("formulation_asked", std::string()) != formulation)
           std::printf("  WARNING: asked for %s, the summary says %s\n", formulation.c_str(),
