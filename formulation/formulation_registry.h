@@ -55,7 +55,7 @@ std::string formulation_names(bool last_or = false);
 // Below this rtol "index3" runs as index2-ggl: index3's position test would ask for positions
 // below their rounding there, and its error stops falling with rtol (docs/formulation.md, "index3
 // hands over to index2-ggl below rtol 1e-6"). "index3-no-handover" is index3 at every rtol.
-constexpr double kIndex3HandoverRtol = 1e-6;
+constexpr double kIndex3HandoverRtol = MultibodyDae::kSpanRtol;
 // Below this rtol "index1" runs as index2-ggl: index1's velocities carry the positions' rounding
 // per step, and the floor its error test keeps above that noise lets the steps' errors add up past
 // 10 rtol at rtol 1e-10 (docs/formulation.md, "index1 hands over to index2-ggl below rtol 1e-9").

@@ -6,7 +6,6 @@
 #include "core/errors.h"
 #include "core/finite_check.h"
 #include "formulation/constraint_rates.h"
-#include "formulation/formulation_registry.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -151,7 +150,7 @@ double MultibodyDae::position_magnitude(const double* y) const {
 }
 
 double MultibodyDae::span_factor(double rtol) const {
-  return max_num(1.0, min_num(min_num(abs_tol_.span / abs_tol_.time, kSpanCap), rtol / kIndex3HandoverRtol));
+  return max_num(1.0, min_num(min_num(abs_tol_.span / abs_tol_.time, kSpanCap), rtol / kSpanRtol));
 }
 
 void MultibodyDae::error_per_unit_span(double h, double noise_step, const double* y, double* w,

@@ -143,6 +143,9 @@ class MultibodyDae : public DaeProblem {
   double newton_cj_ = 0;  // cj of the last Newton matrix (set by jacobian())
 
  public:
+  // The rtol below which index3 hands over to index2-ggl (formulation_registry.h's
+  // kIndex3HandoverRtol is this value): the span factor is at most rtol / kSpanRtol.
+  static constexpr double kSpanRtol = 1e-6;
   // Per-kind absolute tolerances (set once, before integrating; see AbsoluteTolerances).
   void set_absolute_tolerances(const AbsoluteTolerances& a) { abs_tol_ = a; }
   const AbsoluteTolerances& absolute_tolerances() const { return abs_tol_; }
