@@ -33,7 +33,7 @@ const std::vector<Formulation>& formulation_registry() {
          return std::make_unique<Index1Dae>(s, p.constraint_scale,
                                             BaumgarteParameters{p.baumgarte_alpha, p.baumgarte_beta}, false, 0.0);
        },
-       true},
+       true, 1.0},
       {"index1-no-handover",
        "index1 at every rtol, also below 1e-9 where index1 runs as index2-ggl (formulation/index1_dae.h)", false,
        false,
@@ -41,13 +41,13 @@ const std::vector<Formulation>& formulation_registry() {
          return std::make_unique<Index1Dae>(s, p.constraint_scale,
                                             BaumgarteParameters{p.baumgarte_alpha, p.baumgarte_beta}, false, 0.0);
        },
-       true},
+       true, 1.0},
       {"penalty", "index 1 with a penalty term and Baumgarte stabilization (formulation/index1_dae.h)", false, true,
        [](const System& s, const FormulationParameters& p) -> std::unique_ptr<MultibodyDae> {
          return std::make_unique<Index1Dae>(s, p.constraint_scale,
                                             BaumgarteParameters{p.baumgarte_alpha, p.baumgarte_beta}, false, p.penalty);
        },
-       true},
+       true, 5.0},
   };
   return table;
 }

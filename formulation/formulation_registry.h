@@ -38,8 +38,12 @@ struct Formulation {
   // Uses FormulationParameters::penalty (reported in the summary).
   bool uses_penalty = false;
   std::unique_ptr<MultibodyDae> (*make)(const System& sys, const FormulationParameters& p) = nullptr;
-  // Uses the Baumgarte rates (reported in the summary).
+  // Uses the Baumgarte rates (reported in the summary), by default alpha = beta = baumgarte_rate
+  // over the model's fast time scale (docs/formulation.md, "Baumgarte and penalty defaults"):
+  // index1 1 (a faster stabilization makes IDA's steps alternate with error-test failures at
+  // loose tolerances), penalty 5 (its constraint bias goes as 1 / beta^2).
   bool uses_baumgarte = false;
+  double baumgarte_rate = 0;
   // The integrator that advances the DAE, and its name in summary.json.
   Integrator integrator = &integrate;
   const char* integrator_name = "ida";

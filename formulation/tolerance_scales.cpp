@@ -79,6 +79,6 @@ double default_position_atol(const ModelScales& s, double rtol) {
   return kPositionAtolFactor * rtol * s.length;
 }
 
-double default_baumgarte_rate(const ModelScales& s) { return 5.0 / s.fast_time; }
+double default_baumgarte_rate(const ModelScales& s, double per_fast_time) { return per_fast_time / s.fast_time; }
 
 }  // namespace mbdae

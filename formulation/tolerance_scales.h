@@ -36,7 +36,8 @@ double default_position_atol(const ModelScales& s, double rtol);
 // Absolute tolerances in model units from the position tolerance a_q [m] and the scales.
 AbsoluteTolerances absolute_tolerances(const ModelScales& s, double position_atol);
 
-// Default Baumgarte rate alpha = beta [1/s] of index1 and penalty.
-double default_baumgarte_rate(const ModelScales& s);
+// Default Baumgarte rate alpha = beta [1/s]: `per_fast_time` over the model's fast time scale
+// (the formulation's own factor: Formulation::baumgarte_rate; index1 1, penalty 5).
+double default_baumgarte_rate(const ModelScales& s, double per_fast_time);
 
 }  // namespace mbdae

@@ -68,8 +68,10 @@ FormulationParameters formulation_parameters(const System& sys, const Formulatio
   p.constraint_scale = step.constraint_scale > 0 ? step.constraint_scale
                        : f.automatic_scale     ? automatic_constraint_scale(sys, step)
                                                : 1.0;
-  p.baumgarte_alpha = tol.baumgarte_alpha;  // the scene's, else from the model's time scale
-  p.baumgarte_beta = tol.baumgarte_beta;
+  // The scene's rates, else the formulation's default from the model's fast time scale.
+  const double rate = default_baumgarte_rate(tol.scales, f.baumgarte_rate);
+  p.baumgarte_alpha = step.baumgarte_alpha >= 0 ? step.baumgarte_alpha : rate;
+  p.baumgarte_beta = step.baumgarte_beta >= 0 ? step.baumgarte_beta : rate;
   p.penalty = step.penalty;
   js["constraint_scale"] = p.constraint_scale;
   if (f.uses_penalty && p.penalty > 0) js["penalty"] = p.penalty;

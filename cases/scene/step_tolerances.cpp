@@ -24,9 +24,6 @@ StepTolerances step_tolerances(const System& sys, const double* q, const Analysi
     t.absolute.rotation_rate = t.absolute.rotation / t.scales.time;
   }
   if (step.atol_velocity > 0) t.absolute.velocity = f * step.atol_velocity;
-  const double rate = default_baumgarte_rate(t.scales);
-  t.baumgarte_alpha = step.baumgarte_alpha >= 0 ? step.baumgarte_alpha : rate;
-  t.baumgarte_beta = step.baumgarte_beta >= 0 ? step.baumgarte_beta : rate;
   return t;
 }
 

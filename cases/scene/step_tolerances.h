@@ -1,4 +1,4 @@
-// The tolerances and stabilization of an integration step in the model's units: the scene's
+// The tolerances of an integration step in the model's units: the scene's
 // values where given, else derived from the model's scales (formulation/tolerance_scales.h).
 #pragma once
 
@@ -12,7 +12,6 @@ namespace mbdae {
 struct StepTolerances {
   ModelScales scales;
   AbsoluteTolerances absolute;
-  double baumgarte_alpha = 0, baumgarte_beta = 0;
   // rtol / the scene's rtol when the run's rtol differs from the scene's and no atol is given
   // with it: the factor applied to the scene's atol, atol_rotation and atol_velocity (else 1).
   double scene_atol_factor = 1.0;

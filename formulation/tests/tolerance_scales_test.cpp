@@ -25,8 +25,10 @@ TEST(ToleranceScales, PendulumLengthAndTime) {
     EXPECT_NEAR(s.length, d, 1e-12 * d);
     EXPECT_NEAR(s.time, std::sqrt(d / 9.81), 1e-12);
     EXPECT_EQ(s.fast_time, s.time);
-    // Baumgarte alpha = beta = 5 / T_f: 15.7/s for the 1 m pendulum (20/s was the fixed default).
-    EXPECT_NEAR(default_baumgarte_rate(s), 5.0 / std::sqrt(d / 9.81), 1e-9);
+    // Baumgarte alpha = beta = k / T_f (index1 k = 1, penalty 5): 15.7/s for penalty on the 1 m
+    // pendulum (20/s was the fixed default).
+    EXPECT_NEAR(default_baumgarte_rate(s, 5.0), 5.0 / std::sqrt(d / 9.81), 1e-9);
+    EXPECT_NEAR(default_baumgarte_rate(s, 1.0), 1.0 / std::sqrt(d / 9.81), 1e-9);
     // Absolute tolerances in model units from a_q = rtol L.
     const AbsoluteTolerances a = absolute_tolerances(s, default_position_atol(s, 1e-6));
     EXPECT_NEAR(a.position, 1e-6 * d, 1e-20);
@@ -49,7 +51,7 @@ TEST(ToleranceScales, SpanAndSpring) {
   sys.forces.push_back(spring);
   const ModelScales s = model_scales(sys, sys.q0.data(), 0.0, 3.0);
   EXPECT_NEAR(s.fast_time, std::sqrt(2.0 / 800.0), 1e-15);
-  EXPECT_NEAR(default_baumgarte_rate(s), 100.0, 1e-9);
+  EXPECT_NEAR(default_baumgarte_rate(s, 5.0), 100.0, 1e-9);
 }
 
 // index3's velocity error per unit step: the positions' weights are the plain ones times
