@@ -37,7 +37,8 @@ struct AnalysisStep {
   std::string newton_solve = "full";
   bool output_projection = false;    // project output samples onto the constraints
   std::string formulation = "index3";  // index3, index3-positions, index2-ggl, index1 or penalty
-  // index1, penalty: stabilization [1/s]; negative: 5 / the model's fast time scale.
+  // index1, penalty: stabilization [1/s]; negative: the formulation's default over the model's
+  // fast time scale (Formulation::baumgarte_rate: index1 1, penalty 5).
   double baumgarte_alpha = -1, baumgarte_beta = -1;
   double penalty = 1e7;  // penalty: p = penalty * largest body mass [kg] (formulation/index1_dae.h)
   // Report the largest change of these sensors before this time ("nothing moves before").
