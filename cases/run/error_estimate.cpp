@@ -319,12 +319,16 @@ void warn_about(const ErrorEstimate& e) {
                  e.comparison_rtol, e.comparison_status.c_str());
     return;
   }
+  // The penalty formulation's error may be its constraint bias, which a tighter rtol does not remove.
+  const char* advice = e.comparison_penalty > 0 ? "tighten rtol, or raise the penalty if it is the constraint bias "
+                                                  "(docs/formulation.md, \"Singular configurations\")"
+                                                : "tighten rtol";
   for (size_t k = 0; k < e.sensors.size(); ++k)
     if (std::find(e.exceeded.begin(), e.exceeded.end(), e.sensors[k]) != e.exceeded.end())
       std::fprintf(stderr,
                    "mbdae: warning: sensor %s: estimated global error %.3g is %.3g times rtol %g of its scale %.3g "
-                   "(the tolerance promises at most 10): tighten rtol\n",
-                   e.sensors[k].c_str(), e.error[k], e.error[k] / (e.rtol * e.scale[k]), e.rtol, e.scale[k]);
+                   "(the tolerance promises at most 10): %s\n",
+                   e.sensors[k].c_str(), e.error[k], e.error[k] / (e.rtol * e.scale[k]), e.rtol, e.scale[k], advice);
   const double vscale = e.time_scale > 0 ? e.length_scale / e.time_scale : 0.0;
   for (const auto& [name, value, scale] : {std::tuple<const char*, double, double>{"position", e.position_violation, e.length_scale},
                                            {"velocity", e.velocity_violation, vscale}})
