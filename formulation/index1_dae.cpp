@@ -65,7 +65,9 @@ void Index1Dae::error_weights(double h, const double* y, double rtol, double ato
   // v's floor at 5 roundings: its noise is a position's rounding per step, eps |r| / h (q' = v),
   // which does not add up over the steps (v is not integrated from it); at 100 the floor, not
   // rtol, set the steps' summed error from rtol 1e-9 on (docs/formulation.md, "Error control").
-  error_per_unit_span(newton_step(h), newton_step(h), y, w, 1.0, 5.0);
+  // Penalty's velocities also times 1 / span_factor, as index2-ggl's: at loose rtol its phase
+  // error over a long run missed the promise (docs/formulation.md, "penalty's velocities").
+  error_per_unit_span(newton_step(h), newton_step(h), y, w, inverse_penalty_ > 0 ? span_factor(rtol) : 1.0, 5.0);
   for (int i = 2 * nq_; i < size(); ++i) w[i] = 1.0 / (rtol * std::fabs(y[i]) + al);
 }
 
