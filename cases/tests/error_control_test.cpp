@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -193,6 +194,13 @@ Result run_with(const Scene& scene, const char* formulation, double rtol) {
   return r;
 }
 
+// The last step of the scene run with `formulation` at `rtol`, and the summary's notes (none: []).
+std::pair<nlohmann::ordered_json, nlohmann::ordered_json> last_step_and_notes(const Scene& scene, const char* formulation,
+                                                                              double rtol) {
+  const Result r = run_with(scene, formulation, rtol);
+  return {r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array())};
+}
+
 // The fast mechanism: index3's position tolerance sits at the rounding floor from about rtol
 // 1e-7 on (docs/formulation.md, "Index 3 at tight tolerances"); the run says so in a note. At
 // rtol 1e-4 it does not, nor does index2-ggl at 1e-8 (its floor is at about 1e-10).
@@ -217,10 +225,7 @@ TEST(ErrorControlNotes, RoundingFloorIsNoted) {
 // scene's own fixed tolerances, index3 runs as asked; index3-no-handover keeps it at every rtol.
 TEST(ErrorControlNotes, Index3HandsOverBelowOneMillionth) {
   const Scene scene = load_scene(source(kFast));
-  auto step_of = [&](const char* formulation, double rtol) {
-    const Result r = run_with(scene, formulation, rtol);
-    return std::make_pair(r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array()));
-  };
+  auto step_of = [&](const char* formulation, double rtol) { return last_step_and_notes(scene, formulation, rtol); };
   const auto [tight, tight_notes] = step_of("index3", 1e-8);
   EXPECT_EQ(tight["formulation"], "index2-ggl");
   EXPECT_EQ(tight["formulation_asked"], "index3");
@@ -243,10 +248,7 @@ TEST(ErrorControlNotes, Index3HandsOverBelowOneMillionth) {
 // (docs/formulation.md); index1-no-handover keeps index1.
 TEST(ErrorControlNotes, Index1HandsOverBelowOneBillionth) {
   const Scene scene = load_scene(source(kFast));
-  auto step_of = [&](const char* formulation, double rtol) {
-    const Result r = run_with(scene, formulation, rtol);
-    return std::make_pair(r.summary["steps"].back(), r.summary.value("notes", nlohmann::ordered_json::array()));
-  };
+  auto step_of = [&](const char* formulation, double rtol) { return last_step_and_notes(scene, formulation, rtol); };
   const auto [tight, tight_notes] = step_of("index1", 1e-10);
   EXPECT_EQ(tight["formulation"], "index2-ggl");
   EXPECT_EQ(tight["formulation_asked"], "index1");
