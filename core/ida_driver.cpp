@@ -9,7 +9,6 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
-#include <utility>
 
 #include "core/errors.h"
 #include "core/finite_check.h"
