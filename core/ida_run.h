@@ -30,10 +30,14 @@ struct UserData {
   SensitivityProblem* sens = nullptr;  // IdaOptions::sensitivities
   N_Vector state_weights = nullptr;    // the state's weight vector (IDA's first weights_fn call)
   const double* id = nullptr;          // the error test's mask
-  double state_size = 0;               // max |y_i| over the error-tested components, at the last state weights
-  std::vector<double> state_y;         // the state at the last state weights
+  // The sensitivities' largest weights, 1 / (kSensitivityNoise max(|y|, |y_i|)) (+inf where
+  // that is 0), from the state at its last weights.
+  std::vector<double> sensitivity_weight_cap;
   std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
   std::vector<double*> r_out;
+  // The vector IDAS hands the sensitivity residual as F(y): in the staggered corrector it
+  // evaluates F at each step's converged state into it, for its own difference quotients.
+  N_Vector converged_residual = nullptr;
 };
 
 // No C++ exception may cross IDA's C frames: one from the problem's residual or Jacobian (a bug,

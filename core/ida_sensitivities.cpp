@@ -16,6 +16,7 @@ namespace {
 int sensitivity_residual_fn(int ns, sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, N_Vector* s, N_Vector* sp,
                             N_Vector* rs, void* ud, N_Vector, N_Vector, N_Vector) {
   auto* u = static_cast<UserData*>(ud);
+  u->converged_residual = r;
   for (int i = 0; i < ns; ++i) {
     u->s_in[i] = N_VGetArrayPointer(s[i]);
     u->sp_in[i] = N_VGetArrayPointer(sp[i]);
@@ -46,18 +47,20 @@ void sensitivity_weight_floor(UserData* u, N_Vector y, N_Vector w) {
   const int n = u->problem->size();
   if (!u->state_weights) u->state_weights = w;
   double* wd = N_VGetArrayPointer(w);
+  std::vector<double>& cap = u->sensitivity_weight_cap;
   if (w == u->state_weights) {
     const double* yd = N_VGetArrayPointer(y);
-    u->state_size = 0;
+    double size = 0;
     for (int i = 0; i < n; ++i)
-      if (u->id[i] > 0) u->state_size = max_num(u->state_size, std::fabs(yd[i]));
-    u->state_y.assign(yd, yd + n);  // sized once: no allocation after the first call
+      if (u->id[i] > 0) size = max_num(size, std::fabs(yd[i]));
+    cap.resize(n);  // sized once: no allocation after the first call
+    for (int i = 0; i < n; ++i) {
+      const double floor = kSensitivityNoise * max_num(size, std::fabs(yd[i]));
+      cap[i] = floor > 0 ? 1 / floor : INFINITY;
+    }
     return;
   }
-  for (int i = 0; i < n && !u->state_y.empty(); ++i) {
-    const double floor = kSensitivityNoise * max_num(u->state_size, std::fabs(u->state_y[i]));
-    if (floor > 0 && wd[i] * floor > 1) wd[i] = 1 / floor;
-  }
+  for (int i = 0; i < n && !cap.empty(); ++i) wd[i] = wd[i] > cap[i] ? cap[i] : wd[i];
 }
 
 // IDAS's forward sensitivities (IdaOptions::sensitivities): consistent initial values from the

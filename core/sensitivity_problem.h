@@ -19,6 +19,9 @@ class SensitivityProblem {
   // problem's own F there). 0 on success, > 0 recoverable, < 0 fatal (IDA's convention).
   virtual int residual(double t, const double* y, const double* yp, const double* residual,
                        const double* const* s, const double* const* sp, double* const* r) = 0;
+  // Whether residual() reads its `residual` argument; if not, the integrator may leave it
+  // unevaluated.
+  virtual bool reads_state_residual() const { return true; }
   // Consistent (s[i], sp[i]) at the start, (y, y') consistent there. Throws SolveError.
   virtual void initial(double t, const double* y, const double* yp, double* const* s, double* const* sp) = 0;
   // After the problem's restart at t made (y, y') consistent: consistent (s[i], sp[i]) from

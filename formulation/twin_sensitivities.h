@@ -52,6 +52,7 @@ class TwinSensitivities : public SensitivityProblem {
   void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
   void set_segment(double t_start, double t_end) override;
   bool in_error_test() const override { return in_error_test_; }
+  bool reads_state_residual() const override { return false; }
   // From the twins' central differences to the Newton matrix's A0 (exact, dearer). The
   // differences can fail where the steps are tiny, as after IDA starts anew (their rounding,
   // amplified by 1 / h, above the sensitivities' Newton tolerance): from the first failure on,
