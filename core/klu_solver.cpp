@@ -70,6 +70,7 @@ bool KluSolver::factor_fresh() {
     if (!analyze_pattern()) return false;
     return factor_fresh();
   }
+  klu_plan_solve(*symbolic_, *numeric_, plan_);
   return true;
 }
 
@@ -96,7 +97,7 @@ bool KluSolver::factor(const double* values) {
 
 bool KluSolver::solve(double* b) {
   if (!numeric_) return false;
-  klu_solve_one(*symbolic_, *numeric_, b);
+  klu_solve_one(*symbolic_, *numeric_, plan_, b);
   return true;
 }
 
