@@ -21,52 +21,35 @@ inline PackedColumn column(double* lu, const int* start, const int* length, int 
 
 // X[rows[p]] -= values[p] * x for a column, four entries at a time (each row appears once in a
 // column, so the order within it does not change any result).
-inline void subtract_column(double* __restrict X, const int* __restrict rows, const double* __restrict values,
-                            int size, double x) {
+inline void subtract_column(double* __restrict X, const PackedColumn& c, double x) {
+  const int* __restrict rows = c.rows;
+  const double* __restrict values = c.values;
   int p = 0;
-  for (; p + 4 <= size; p += 4) {
+  for (; p + 4 <= c.size; p += 4) {
     const double a0 = values[p] * x, a1 = values[p + 1] * x, a2 = values[p + 2] * x, a3 = values[p + 3] * x;
     X[rows[p]] -= a0;
     X[rows[p + 1]] -= a1;
     X[rows[p + 2]] -= a2;
     X[rows[p + 3]] -= a3;
   }
-  for (; p < size; ++p) X[rows[p]] -= values[p] * x;
+  for (; p < c.size; ++p) X[rows[p]] -= values[p] * x;
 }
 
-inline void subtract_column(double* X, const PackedColumn& c, double x) {
-  subtract_column(X, c.rows, c.values, c.size, x);
+// L U x = x for one diagonal block of size nk (L unit lower, U's diagonal apart).
+void solve_block(const klu_numeric& N, int block, int k1, int nk, double* X) {
+  double* lu = static_cast<double*>(N.LUbx[block]);
+  const double* udiag = static_cast<const double*>(N.Udiag) + k1;
+  for (int k = 0; k < nk; ++k) subtract_column(X, column(lu, N.Lip + k1, N.Llen + k1, k), X[k]);
+  for (int k = nk - 1; k >= 0; --k) {
+    const double x = X[k] / udiag[k];
+    X[k] = x;
+    subtract_column(X, column(lu, N.Uip + k1, N.Ulen + k1, k), x);
+  }
 }
 
 }  // namespace
 
-void klu_plan_solve(const klu_symbolic& S, const klu_numeric& N, KluSolvePlan& plan) {
-  const int n = S.n;
-  plan.l_begin.assign(n + 1, 0);
-  plan.u_begin.assign(n + 1, 0);
-  plan.l_values.assign(n, nullptr);
-  plan.u_values.assign(n, nullptr);
-  plan.rows.clear();
-  for (int pass = 0; pass < 2; ++pass) {  // L's columns, then U's
-    std::vector<int>& begin = pass == 0 ? plan.l_begin : plan.u_begin;
-    std::vector<const double*>& values = pass == 0 ? plan.l_values : plan.u_values;
-    for (int block = 0; block < S.nblocks; ++block) {
-      const int k1 = S.R[block], k2 = S.R[block + 1];
-      double* lu = static_cast<double*>(N.LUbx[block]);
-      for (int k = k1; k < k2; ++k) {
-        begin[k] = static_cast<int>(plan.rows.size());
-        if (k2 - k1 == 1) continue;  // a 1 x 1 block: U's diagonal alone
-        const PackedColumn c = pass == 0 ? column(lu, N.Lip + k1, N.Llen + k1, k - k1)
-                                         : column(lu, N.Uip + k1, N.Ulen + k1, k - k1);
-        for (int p = 0; p < c.size; ++p) plan.rows.push_back(c.rows[p] + k1);
-        values[k] = c.values;
-      }
-    }
-    begin[n] = static_cast<int>(plan.rows.size());
-  }
-}
-
-void klu_solve_one(const klu_symbolic& S, const klu_numeric& N, const KluSolvePlan& plan, double* b) {
+void klu_solve_one(const klu_symbolic& S, const klu_numeric& N, double* b) {
   const int n = S.n;
   double* X = static_cast<double*>(N.Xwork);
   // X = P (R \ b): the gather, then the divisions in a loop of their own (it vectorizes; IEEE
@@ -76,21 +59,12 @@ void klu_solve_one(const klu_symbolic& S, const klu_numeric& N, const KluSolvePl
     for (int k = 0; k < n; ++k) X[k] /= rs[k];
   const double* udiag = static_cast<const double*>(N.Udiag);
   const double* off = static_cast<const double*>(N.Offx);
-  const int* rows = plan.rows.data();
   for (int block = S.nblocks - 1; block >= 0; --block) {
     const int k1 = S.R[block], k2 = S.R[block + 1];
-    if (k2 - k1 == 1) {
+    if (k2 - k1 == 1)
       X[k1] /= udiag[k1];
-    } else {
-      // L U x = x for the block (L unit lower, U's diagonal apart).
-      for (int k = k1; k < k2; ++k)
-        subtract_column(X, rows + plan.l_begin[k], plan.l_values[k], plan.l_begin[k + 1] - plan.l_begin[k], X[k]);
-      for (int k = k2 - 1; k >= k1; --k) {
-        const double x = X[k] / udiag[k];
-        X[k] = x;
-        subtract_column(X, rows + plan.u_begin[k], plan.u_values[k], plan.u_begin[k + 1] - plan.u_begin[k], x);
-      }
-    }
+    else
+      solve_block(N, block, k1, k2 - k1, X + k1);
     if (block == 0) break;
     // The off-diagonal blocks' back substitution.
     for (int k = k1; k < k2; ++k) {

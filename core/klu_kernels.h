@@ -8,24 +8,11 @@
 
 #include <klu.h>
 
-#include <vector>
-
 namespace mbdae {
 
-// Where each column of a factorization's L and U is, laid out once per fresh factorization
-// (klu_refactor writes the same places): the columns' row indices counted from the matrix's
-// first row, contiguous, and each column's values in KLU's packed blocks. The solve's inner loop
-// then reads an index and a value per entry, not the packed columns' headers.
-struct KluSolvePlan {
-  std::vector<int> l_begin, u_begin;  // column k's rows: rows[begin[k]] .. rows[begin[k + 1] - 1]
-  std::vector<int> rows;
-  std::vector<const double*> l_values, u_values;  // column k's values
-};
-void klu_plan_solve(const klu_symbolic& symbolic, const klu_numeric& numeric, KluSolvePlan& plan);
-
-// Solves A x = b in place for the factorization (symbolic, numeric) of A, whose plan is `plan`;
-// uses numeric's Xwork as klu_solve does.
-void klu_solve_one(const klu_symbolic& symbolic, const klu_numeric& numeric, const KluSolvePlan& plan, double* b);
+// Solves A x = b in place for the factorization (symbolic, numeric) of A; uses numeric's Xwork
+// as klu_solve does.
+void klu_solve_one(const klu_symbolic& symbolic, const klu_numeric& numeric, double* b);
 
 // klu_refactor of A (colptr, rowind, values: the analyzed pattern) into numeric, for common.scale
 // > 0, numeric's row scale present and common.halt_if_singular (KLU's defaults; else it calls

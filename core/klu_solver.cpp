@@ -70,7 +70,6 @@ bool KluSolver::factor_fresh() {
     if (!analyze_pattern()) return false;
     return factor_fresh();
   }
-  klu_plan_solve(*symbolic_, *numeric_, plan_);
   return true;
 }
 
@@ -97,7 +96,7 @@ bool KluSolver::factor(const double* values) {
 
 bool KluSolver::solve(double* b) {
   if (!numeric_) return false;
-  klu_solve_one(*symbolic_, *numeric_, plan_, b);
+  klu_solve_one(*symbolic_, *numeric_, b);
   return true;
 }
 

@@ -9,7 +9,6 @@
 
 #include <vector>
 
-#include "core/klu_kernels.h"
 #include "core/sparse_assembler.h"
 
 namespace mbdae {
@@ -47,7 +46,6 @@ class KluSolver {
   klu_common common_;
   klu_symbolic* symbolic_ = nullptr;
   klu_numeric* numeric_ = nullptr;
-  KluSolvePlan plan_;  // of numeric_, from its fresh factorization
   CscPattern pattern_;
   std::vector<double> values_;
   int factorizations_ = 0, full_factorizations_ = 0;
