@@ -92,6 +92,11 @@ bool expect_same_refactorization(Csc a, const std::vector<double>& new_values, i
                            len * sizeof(double)))
               << "block " << b << " column " << k;
         }
+    std::vector<double> b(a.n), x(a.n);
+    for (int i = 0; i < a.n; ++i) b[i] = x[i] = std::sin(1.0 + i);
+    EXPECT_TRUE(klu_solve(s, theirs, a.n, 1, b.data(), &common));
+    klu_solve_one(*s, *ours, x.data());
+    EXPECT_TRUE(same(b.data(), x.data(), a.n * sizeof(double))) << "the solve after the refactorization";
   }
   klu_free_numeric(&theirs, &common);
   klu_free_numeric(&ours, &common);
