@@ -147,6 +147,7 @@ bool drop_sensitivities(IdaRun& r, int flag) {
   r.stats.sensitivity_failure = os.str();
   check(IDASensToggleOff(r.mem), "IDASensToggleOff");
   r.sens_on = false;
+  r.ud.converged_residual = nullptr;  // every residual IDA asks for from here on is evaluated
   back_to_last_step(r);
   start_again(r);
   return true;
