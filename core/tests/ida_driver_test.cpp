@@ -267,5 +267,40 @@ TEST(IdaDriverSensitivities, AFailureStopsThemNotTheRun) {
   EXPECT_NEAR(y[0], std::exp(-2.0), 1e-5);
 }
 
+// IDAS evaluates the state's residual at each step's converged state for the sensitivity
+// residual's `residual` argument: evaluated where the problem reads it, skipped where it does
+// not, with the same steps and the same numbers either way.
+TEST(IdaDriverSensitivities, ConvergedStateResidualOnlyWhereRead) {
+  struct Unread : DecayInitialValue {
+    bool reads_state_residual() const override { return false; }
+  };
+  long calls[2] = {0, 0}, steps[2] = {0, 0};
+  std::vector<double> last[2];
+  for (int k = 0; k < 2; ++k) {
+    DecayProblem p;
+    DecayInitialValue reads;
+    Unread unread;
+    std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+    IdaOptions o;
+    o.t1 = 2;
+    o.rtol = 1e-8;
+    o.atol = 1e-10;
+    o.output_step = 0.5;
+    o.sensitivities = k == 0 ? static_cast<SensitivityProblem*>(&reads) : &unread;
+    o.sensitivity_output = [&](double, const double*, const double*, const double* const* s, const double* const*) {
+      last[k] = {s[0][0], s[0][1]};
+    };
+    const IdaStats st = integrate(p, o, y, yp, [](double, const double*, const double*) { return true; });
+    ASSERT_TRUE(st.ok) << st.message;
+    last[k].push_back(y[0]);
+    calls[k] = p.residual_calls;
+    steps[k] = st.steps;
+  }
+  EXPECT_EQ(steps[0], steps[1]);
+  EXPECT_EQ(last[0], last[1]);  // bit for bit
+  // One per step but the first (its vector is known from the first sensitivity residual on).
+  EXPECT_GE(calls[0] - calls[1], steps[0] - 1) << calls[0] << " against " << calls[1];
+}
+
 }  // namespace
 }  // namespace mbdae
