@@ -58,7 +58,7 @@ int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
   auto* u = static_cast<UserData*>(ud);
   // IDAS's F at a step's converged state, for a sensitivity residual that does not read it: not
   // evaluated (a residual per step; the state's Newton iterations write elsewhere).
-  if (r == u->converged_residual && !u->sens->reads_state_residual()) return 0;
+  if (r == u->unread_residual) return 0;
   try {
     return u->problem->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r));
   } catch (const SolveError& e) {

@@ -35,9 +35,10 @@ struct UserData {
   std::vector<double> sensitivity_weight_cap;
   std::vector<const double*> s_in, sp_in;  // the sensitivity residual's arguments as arrays
   std::vector<double*> r_out;
-  // The vector IDAS hands the sensitivity residual as F(y): in the staggered corrector it
+  // The vector IDAS hands the sensitivity residual as F(y), where that residual does not read it
+  // (SensitivityProblem::reads_state_residual), else null: in the staggered corrector IDAS
   // evaluates F at each step's converged state into it, for its own difference quotients.
-  N_Vector converged_residual = nullptr;
+  N_Vector unread_residual = nullptr;
 };
 
 // No C++ exception may cross IDA's C frames: one from the problem's residual or Jacobian (a bug,

@@ -16,7 +16,7 @@ namespace {
 int sensitivity_residual_fn(int ns, sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, N_Vector* s, N_Vector* sp,
                             N_Vector* rs, void* ud, N_Vector, N_Vector, N_Vector) {
   auto* u = static_cast<UserData*>(ud);
-  u->converged_residual = r;
+  if (!u->sens->reads_state_residual()) u->unread_residual = r;
   for (int i = 0; i < ns; ++i) {
     u->s_in[i] = N_VGetArrayPointer(s[i]);
     u->sp_in[i] = N_VGetArrayPointer(sp[i]);
@@ -147,7 +147,7 @@ bool drop_sensitivities(IdaRun& r, int flag) {
   r.stats.sensitivity_failure = os.str();
   check(IDASensToggleOff(r.mem), "IDASensToggleOff");
   r.sens_on = false;
-  r.ud.converged_residual = nullptr;  // every residual IDA asks for from here on is evaluated
+  r.ud.unread_residual = nullptr;  // every residual IDA asks for from here on is evaluated
   back_to_last_step(r);
   start_again(r);
   return true;
