@@ -128,10 +128,13 @@ void AugmentedSolver::predict_accelerations(double t, int points, double* x) con
   double w[kHistory];
   extrapolation_weights(t, points, w);
   const int n = nq_ + nc_;
-  for (int k = 0; k < n; ++k) {
-    double s = 0;
-    for (int i = 0; i < points; ++i) s += w[i] * history_[i][k];
-    x[k] = s;
+  // Sample by sample over contiguous arrays (the loops vectorize); each x[k] sums its terms in
+  // the same order as a loop over the samples per entry would.
+  std::fill(x, x + n, 0.0);
+  for (int i = 0; i < points; ++i) {
+    const double wi = w[i];
+    const double* h = history_[i].data();
+    for (int k = 0; k < n; ++k) x[k] += wi * h[k];
   }
 }
 
