@@ -470,6 +470,12 @@ bool over_budget(IdaRun& r) {
   if (steps < o.max_total_steps)
     os << ", and at the rate of the last " << kWatchStrikes * kWatchWindow << " steps the run to t = " << o.t1
        << " would need about " << projected << " steps";
+  // The sensitivities' error test may be what holds the steps back (their differences' noise):
+  // the run goes on without them (or with their assembled Newton matrix), within its budget.
+  if (r.sens_on && steps < o.max_total_steps) {
+    r.watch_strikes = 0;
+    return !drop_sensitivities(r, os.str() + " with the sensitivities");
+  }
   os << ", more than max_steps = " << static_cast<double>(o.max_total_steps)
      << " (a load or a motion growing without bound? raise max_steps in the step to go on; docs/errors.md)";
   fail(r, "step_limit", os.str(), r.t);

@@ -144,5 +144,7 @@ bool sensitivities_at_last_step(IdaRun& r);
 // IDA failed with the sensitivities on: their robust residual from the last accepted step, or
 // the run on without them. True: the run goes on.
 bool drop_sensitivities(IdaRun& r, int flag);
+// The same for a reason of the driver's own (the steps held back by the sensitivities).
+bool drop_sensitivities(IdaRun& r, const std::string& why);
 
 }  // namespace mbdae::ida_detail

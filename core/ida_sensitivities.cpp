@@ -137,13 +137,18 @@ static bool retry_sensitivities(IdaRun& r) {
 // step (their rows end there; IdaStats::sensitivity_failure says why). Where the state itself
 // cannot go on, it fails again there and the run ends with that failure.
 bool drop_sensitivities(IdaRun& r, int flag) {
-  if (r.o->sensitivities->fall_back() && retry_sensitivities(r)) return true;
   double tt = r.t;
   IDAGetCurrentTime(r.mem, &tt);
   std::ostringstream os;
   os << "IDA failed with the sensitivities at t = " << tt << " (" << ida_flag_name(flag) << ")";
   if (!r.ud.callback_error.empty()) os << ": " << r.ud.callback_error;
-  os << "; the run went on without them from t = " << r.t_prev;
+  return drop_sensitivities(r, os.str());
+}
+
+bool drop_sensitivities(IdaRun& r, const std::string& why) {
+  if (r.o->sensitivities->fall_back() && retry_sensitivities(r)) return true;
+  std::ostringstream os;
+  os << why << "; the run went on without them from t = " << r.t_prev;
   r.stats.sensitivity_failure = os.str();
   check(IDASensToggleOff(r.mem), "IDASensToggleOff");
   r.sens_on = false;

@@ -244,6 +244,17 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
   const int last = options.analysis >= 0 ? options.analysis : static_cast<int>(scene.steps.size()) - 1;
   for (int k = 0; k <= last && k < static_cast<int>(scene.steps.size()); ++k)
     if (!run_step(c, k)) break;
+  // Sensitivities that stopped while the run went on leave sensitivities.csv short of
+  // results.csv: not a whole run (status sensitivities_failed, exit code 3).
+  // (Their failure was said on stderr when it happened: sensitivities_failed.)
+  if (result.exit_code == 0 && c.sensitivities && c.sensitivities->status != "ok") {
+    summary["status"] = result.status = "sensitivities_failed";
+    summary["message"] = result.message = "the sensitivities stopped (" + c.sensitivities->status + "): " +
+                                          c.sensitivities->message + "; results.csv is whole, sensitivities.csv ends there";
+    close_summary(c);
+    result.exit_code = 3;
+    result.q = c.q;
+  }
   if (result.exit_code == 0) {
     summary["status"] = "ok";
     close_summary(c);

@@ -33,6 +33,12 @@ std::string number_text(double v) {
   return buf;
 }
 
+std::string short_text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
 // "m/(N/m)": a sensitivity's unit from the sensor's and the parameter's.
 std::string ratio_unit(const std::string& y, const std::string& p) {
   if (p.empty() || p == "1") return y;
@@ -64,6 +70,30 @@ std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParamet
   tw->context->q = sys->q0;
   output_columns(*tw->context);
   return tw;
+}
+
+// A parameter that moves the time of a breakpoint (the ground step's time, a drive's switch)
+// inside an integrated step: the sensitivities jump there by (y'- - y'+) dt_b/dp, which the
+// twins' restart at the run's breakpoint does not give (the rows after it were measured 2.3
+// times off). Refused, naming the breakpoint.
+void check_breakpoints(const RunContext& c, const SensitivityParameter& p) {
+  const std::vector<double> own = c.system->breakpoints();
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<double> twin = p.twin[side]->context->system->breakpoints();
+    for (size_t k = 0; k < std::max(own.size(), twin.size()); ++k) {
+      const double b = k < own.size() ? own[k] : twin[k], bt = k < twin.size() ? twin[k] : NAN;
+      if (k < own.size() && k < twin.size() && std::fabs(bt - b) <= 1e-14 * std::max(1.0, std::fabs(b))) continue;
+      for (const AnalysisStep& step : c.scene.steps) {
+        const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
+        if (!integrated || !(b > step.t0 && b < step.t_end)) continue;
+        throw ModelError(c.scene.file, 0, "sensitivities",
+                         "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) +
+                             " with " + p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
+                             "), inside an integrated step: the sensitivities would jump there by (y'- - y'+) dt/dp, "
+                             "which is not computed; it cannot be differentiated");
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -145,6 +175,7 @@ std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c) {
     p.delta = kRelativeStep * p.scale;
     p.twin[0] = make_twin(c, p, p.value + p.delta);
     p.twin[1] = make_twin(c, p, p.value - p.delta);
+    check_breakpoints(c, p);
     rs->parameters.push_back(std::move(p));
   }
   // Columns: each output sensor by each parameter.
@@ -319,8 +350,15 @@ void close_sensitivities(RunContext& c) {
                        "the jump (y'- - y'+) dt_event/dp is zero because every switching force (wheel_contact) is "
                        "continuous at its switch (docs/sensitivities.md)";
   }
-  j["status"] = rs.status;
-  if (!rs.message.empty()) j["message"] = rs.message;
+  // A run that stopped (failed, interrupted) ends the sensitivities' rows with its own.
+  const std::string run_status = c.result.summary.value("status", std::string());
+  if (rs.status == "ok" && run_status != "ok") {
+    j["status"] = run_status;
+    j["message"] = "the run stopped (" + run_status + "): the sensitivities' rows end with its rows";
+  } else {
+    j["status"] = rs.status;
+    if (!rs.message.empty()) j["message"] = rs.message;
+  }
   c.result.summary["sensitivities"] = j;
 }
 
