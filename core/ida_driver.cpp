@@ -323,6 +323,7 @@ void reinit(IdaRun& r, double tt) {
   if (r.sens_on) {
     check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
     r.o->sensitivities->reinitialized();
+    sensitivity_test_window(r, true);
   }
 }
 
@@ -414,6 +415,7 @@ bool advance(IdaRun& r) {
   }
   if (!finite(r, data(r.y), tret, "")) return false;
   if (!newton_matrix_fine(r, tret)) return false;
+  sensitivity_test_window(r, false);
   if (tret > o.t1) {
     finish_past_end(r, flag, tret);
     return false;

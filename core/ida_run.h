@@ -99,6 +99,10 @@ struct IdaRun {
   // between IDAS calls) and of a sample's interpolated ones; their data pointers.
   int ns = 0;
   bool sens_on = false;  // false once IDA failed with them (drop_sensitivities)
+  // The sensitivities out of the local error test for sens_free_steps more steps after a start
+  // of IDA, once a failure took them out (sensitivities_out_of_test): window and failures.
+  long sens_free_steps = 0, sens_free_window = 0;
+  int sens_test_failures = 0;
   N_Vector *s = nullptr, *sp = nullptr, *ss = nullptr, *sps = nullptr;
   std::vector<double*> s_data, sp_data, ss_data, sps_data;
   std::vector<double> pbar;
@@ -146,5 +150,8 @@ bool sensitivities_at_last_step(IdaRun& r);
 bool drop_sensitivities(IdaRun& r, int flag);
 // The same for a reason of the driver's own (the steps held back by the sensitivities).
 bool drop_sensitivities(IdaRun& r, const std::string& why);
+// At a start of IDA (start) and after each accepted step: the sensitivities' error test off
+// for the window that a failure in it opened (sensitivities_out_of_test).
+void sensitivity_test_window(IdaRun& r, bool start);
 
 }  // namespace mbdae::ida_detail

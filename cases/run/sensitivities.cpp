@@ -15,6 +15,7 @@
 #include "formulation/mechanics.h"  // initial_modes
 #include "formulation/model_rules.h"  // did_you_mean
 #include "formulation/kinematic_sensitivities.h"
+#include "formulation/tolerance_scales.h"
 #include "formulation/twin_sensitivities.h"
 
 namespace mbdae {
@@ -96,6 +97,26 @@ void check_breakpoints(const RunContext& c, const SensitivityParameter& p) {
   }
 }
 
+// The scale of the twins' step d = kRelativeStep scale. A length's is the model's length scale
+// (formulation/tolerance_scales.h) where |p| is smaller: a point's coordinate depends on where
+// the origin is, and one at 0 or 1e-12 m on a 1 m suspension is moved as any other point of it.
+// A mass's or an inertia's is |p|, but not below 1e-3 of the model's largest (a wheel of 1e-15
+// kg beside a 400 kg chassis, moved by 3e-5 |p|, made twins that differed by rounding only:
+// sensitivities of exactly 0). An angle's at least 1 rad (57.3 deg). Otherwise |p|, or 1 in p's unit at 0.
+double parameter_scale(const RunContext& c, double value, const std::string& unit) {
+  const System& sys = *c.system;
+  double floor = 0;
+  if (unit == "m") floor = model_scales(sys, sys.q0.data(), 0, 1).length;
+  if (unit == "rad") floor = 1;
+  if (unit == "deg") floor = 180 / M_PI;
+  for (const SystemBody& b : sys.bodies) {
+    if (unit == "kg") floor = std::max(floor, 1e-3 * b.mass);
+    if (unit == "kg m^2") floor = std::max(floor, 1e-3 * b.inertia.cwiseAbs().maxCoeff());
+  }
+  const double scale = std::max(std::fabs(value), floor);
+  return scale > 0 ? scale : 1.0;
+}
+
 }  // namespace
 
 bool sensitivity_formulation(const std::string& formulation) { return formulation.rfind("index3", 0) != 0; }
@@ -171,7 +192,7 @@ std::shared_ptr<RunSensitivities> open_sensitivities(RunContext& c) {
     p.path = path;
     p.unit = e.unit;
     parse_number(e.value, p.value);
-    p.scale = p.value != 0 ? std::fabs(p.value) : 1.0;
+    p.scale = parameter_scale(c, p.value, p.unit);
     p.delta = kRelativeStep * p.scale;
     p.twin[0] = make_twin(c, p, p.value + p.delta);
     p.twin[1] = make_twin(c, p, p.value - p.delta);
@@ -287,6 +308,8 @@ void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
     stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
     stats["sensitivity_fallbacks"] = st.sensitivity_fallbacks;
   }
+  // Where a failure first took them out of the local error test for a window after each start.
+  if (st.sensitivity_test_off_time >= 0) stats["sensitivity_error_test_windows_from"] = st.sensitivity_test_off_time;
   RunSensitivities& rs = *c.sensitivities;
   rs.event_times.insert(rs.event_times.end(), st.event_times.begin(), st.event_times.end());
 }

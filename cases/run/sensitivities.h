@@ -36,7 +36,7 @@ struct TwinRun {
 struct SensitivityParameter {
   std::string path, unit;
   double value = 0;
-  double scale = 1;  // |value|, or 1 in its unit where the value is 0
+  double scale = 1;  // |value|, not below the model's own size in its unit (parameter_scale)
   double delta = 0;  // the twins' step, kRelativeStep * scale
   std::unique_ptr<TwinRun> twin[2];  // p + d, p - d
 };

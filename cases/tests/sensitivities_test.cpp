@@ -163,6 +163,27 @@ TEST(Sensitivities, BadRequestsAreRefusedBeforeTheRun) {
   EXPECT_THROW(run(scene, twice), ModelError);
 }
 
+// Sensitivities that stop while the run goes on leave fewer sensitivity rows than results
+// rows: the run is not `ok` but sensitivities_failed (exit code 3), its results whole. Here a
+// sensor that is not finite for the twin above the start (sqrt(0.2 - z) at z = 0.2 + d).
+TEST(Sensitivities, StoppedSensitivitiesAreNotAWholeRun) {
+  std::string text = oscillator("index2-ggl");
+  const std::string analysis = "analysis:\n";
+  text.replace(text.find(analysis), analysis.size(),
+               "  - {name: gap, type: expression, expression: \"sqrt(0.2 - z)\"}\n" + analysis);
+  RunOptions opt;
+  opt.sensitivities = {"coordinates.s.initial"};
+  opt.report_failures = false;
+  const Result r = run(load_scene_text(text, "oscillator.yaml"), opt);
+  EXPECT_EQ(r.status, "sensitivities_failed") << r.message;
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.summary["status"], "sensitivities_failed");
+  EXPECT_EQ(r.summary["sensitivities"]["status"], "not_finite");
+  EXPECT_EQ(r.rows(), 81u);
+  EXPECT_LT(r.sensitivities[0].size(), r.rows());
+  EXPECT_EQ(r.summary["sensitivities"]["rows"], r.sensitivities[0].size());
+}
+
 class SensitivitiesCli : public test_support::RunFolderTest {
  protected:
   SensitivitiesCli() : RunFolderTest("mbdae_sens_") {}
