@@ -117,6 +117,7 @@ struct RunInfo {
   const AnalysisStep* step = nullptr;
   const std::vector<std::string>* columns = nullptr;
   const std::vector<std::string>* units = nullptr;
+  const Result* result = nullptr;  // the run's result as it grows (sensitivity rows: SensitivityCsvSink)
 };
 
 // One output sample: the row of column values and the consistent state it came from, for sinks

@@ -33,9 +33,36 @@ void write_columns(const std::string& path, const std::vector<std::string>& name
 
 }  // namespace
 
+void SensitivityCsvSink::begin(const RunInfo& info) {
+  result_ = info.result;
+  if (open_ || !result_ || result_->sensitivity_columns.empty()) return;
+  csv_.open(path_, result_->sensitivity_columns);
+  row_.resize(result_->sensitivity_columns.size());
+  open_ = true;
+}
+
+void SensitivityCsvSink::sample(const Sample&) {
+  if (open_) write_rows(*result_);
+}
+
+void SensitivityCsvSink::write_rows(const Result& r) {
+  const size_t rows = r.sensitivities.empty() ? 0 : r.sensitivities[0].size();
+  for (; written_ < rows; ++written_) {
+    for (size_t k = 0; k < row_.size(); ++k) row_[k] = r.sensitivities[k][written_];
+    csv_.row(row_.data());
+    if (csv_.rows() % 256 == 0) csv_.flush();
+  }
+}
+
 void SensitivityCsvSink::end(const Result& r) {
   if (r.sensitivity_columns.empty()) return;
-  write_columns(path_, r.sensitivity_columns, r.sensitivities);
+  if (!open_) {  // no integration step (static steps only): the header
+    csv_.open(path_, r.sensitivity_columns);
+    row_.resize(r.sensitivity_columns.size());
+    open_ = true;
+  }
+  write_rows(r);
+  csv_.close();
   if (normalized_path_.empty()) return;
   const NormalizedSensitivities n = normalized_sensitivities(r);
   write_columns(normalized_path_, n.columns, n.data);

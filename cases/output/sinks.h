@@ -27,17 +27,27 @@ class CsvSink : public Sink {
   CsvWriter csv_;
 };
 
-// sensitivities.csv (RunOptions::sensitivities) when the run ends: Result::sensitivities, the
-// rows computed (also of a failed run), through PATH.partial like results.csv.
-// With `normalized_path`, also normalized_sensitivities() there.
+// sensitivities.csv (RunOptions::sensitivities): the rows of Result::sensitivities as they are
+// computed (each sample's row comes after the sample itself: written at the next sample and at
+// the end), through PATH.partial like results.csv, so that a killed run keeps whole rows.
+// With `normalized_path`, normalized_sensitivities() there when the run ends (it scales by
+// each sensor's largest value over the run).
 class SensitivityCsvSink : public Sink {
  public:
   SensitivityCsvSink(std::string path, std::string normalized_path)
       : path_(std::move(path)), normalized_path_(std::move(normalized_path)) {}
+  void begin(const RunInfo& info) override;
+  void sample(const Sample& s) override;
   void end(const Result& result) override;
 
  private:
+  void write_rows(const Result& r);  // the rows computed since the last call
   std::string path_, normalized_path_;
+  const Result* result_ = nullptr;
+  CsvWriter csv_;
+  bool open_ = false;
+  size_t written_ = 0;
+  std::vector<double> row_;
 };
 
 // summary.json at the end of the run (written atomically: core/output.h write_json_file).

@@ -475,7 +475,7 @@ bool integration_stage(RunContext& c, const AnalysisStep& step, json& js) {
   js["newton_solve"] = io.reduced_newton && dae->kinematic_rows() > 0 ? "reduced" : "full";
   std::vector<double> y, yp;
   if (!start(c, step, *dae, y, yp, js)) return false;
-  const RunInfo info{&c.scene, &sys, &step, &c.result.columns, &c.result.units};
+  const RunInfo info{&c.scene, &sys, &step, &c.result.columns, &c.result.units, &c.result};
   try {
     for (Sink* s : c.sinks) s->begin(info);
   } catch (const std::exception& e) {

@@ -4,6 +4,8 @@
 // are parsed: whole rows only, valid JSON, and never "ok" or exit 0 over an incomplete file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <fcntl.h>
 #include <sys/file.h>
 #include <signal.h>
@@ -100,14 +102,19 @@ class OutputFaults : public mbdae::test_support::RunFolderTest {
     std::ofstream(dir / name) << text;
     return (dir / name).string();
   }
-  // Starts `mbdae run SCENE --out OUT --quiet` in the background; stderr to dir/NAME.log.
-  pid_t start(const std::string& scene_path, const std::string& log) {
+  // Starts `mbdae run SCENE --out OUT --quiet` in the background (with `--sensitivity PATH` if
+  // given); stderr to dir/NAME.log.
+  pid_t start(const std::string& scene_path, const std::string& log, const char* sensitivity = nullptr) {
     const pid_t pid = fork();
     if (pid == 0) {
       const int fd = ::open((dir / log).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       dup2(fd, 1);
       dup2(fd, 2);
-      execl(MBDAE_EXE, MBDAE_EXE, "run", scene_path.c_str(), "--out", out.c_str(), "--quiet", (char*)nullptr);
+      if (sensitivity)
+        execl(MBDAE_EXE, MBDAE_EXE, "run", scene_path.c_str(), "--out", out.c_str(), "--quiet", "--sensitivity",
+              sensitivity, (char*)nullptr);
+      else
+        execl(MBDAE_EXE, MBDAE_EXE, "run", scene_path.c_str(), "--out", out.c_str(), "--quiet", (char*)nullptr);
       _exit(127);
     }
     return pid;
@@ -254,6 +261,37 @@ TEST_F(OutputFaults, SigkillLeavesWholeRows) {
     EXPECT_FALSE(fs::exists(out / "results.csv"));
     EXPECT_FALSE(fs::exists(out / "summary.json"));
   }
+}
+
+// The same with sensitivities: sensitivities.csv is written as its rows come (each after its
+// sample), through .partial, so a killed run keeps whole rows of both files.
+TEST_F(OutputFaults, SigkillLeavesWholeSensitivityRows) {
+  const pid_t pid = start(scene("10000"), "run.log", "bodies.arm.mass");
+  ASSERT_TRUE(wait_for_rows(pid, 60000));
+  kill(pid, SIGKILL);
+  int sig = 0;
+  wait_exit(pid, &sig);
+  EXPECT_EQ(sig, SIGKILL);
+  const int reader = ::open((out / "sensitivities.csv.partial").c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(reader, 0);
+  EXPECT_EQ(::flock(reader, LOCK_SH), 0);
+  ::close(reader);
+  const long results = check_whole_rows(out / "results.csv.partial");
+  const std::string text = read_file(out / "sensitivities.csv.partial");
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, R"x(t,d(angle)/d(bodies.arm.mass),"d(a,b""c)/d(bodies.arm.mass)")x");
+  long rows = 0;
+  while (std::getline(in, line)) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 2) << "row " << rows + 1 << ": '" << line << "'";
+    ++rows;
+  }
+  EXPECT_GT(rows, 100);
+  EXPECT_LE(rows, results);
+  EXPECT_FALSE(fs::exists(out / "sensitivities.csv"));
 }
 
 // Overrides out of the scene fields' ranges are refused with the scene fields' messages.
