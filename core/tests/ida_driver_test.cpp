@@ -267,6 +267,38 @@ TEST(IdaDriverSensitivities, AFailureStopsThemNotTheRun) {
   EXPECT_NEAR(y[0], std::exp(-2.0), 1e-5);
 }
 
+// Sensitivities whose local error test fails where their Newton iteration converges (forcing
+// that is rough in t, a hash of it): out of the test for windows after each start of IDA
+// (core/ida_sensitivities.cpp, sensitivities_out_of_test), they go on to the end.
+TEST(IdaDriverSensitivities, AFailureInTheirErrorTestTakesThemOutOfIt) {
+  struct Rough : DecayInitialValue {
+    int residual(double t, const double*, const double*, const double*, const double* const* s, const double* const* sp,
+                 double* const* r) override {
+      const double g = 1e3 * (std::fmod(std::fabs(std::sin(t * 1e5) * 43758.5453), 1.0) - 0.5);
+      r[0][0] = sp[0][0] + s[0][0] - g;
+      r[0][1] = s[0][1] - 2 * s[0][0];
+      return 0;
+    }
+  };
+  DecayProblem p;
+  Rough sens;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.output_step = 0.1;
+  o.sensitivities = &sens;
+  double last_sensitivity = -1;
+  o.sensitivity_output = [&](double t, const double*, const double*, const double* const*, const double* const*) {
+    last_sensitivity = t;
+  };
+  const IdaStats st = integrate(p, o, y, yp, [](double, const double*, const double*) { return true; });
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_TRUE(st.sensitivity_failure.empty()) << st.sensitivity_failure;
+  EXPECT_GE(st.sensitivity_test_off_time, 0.0);
+  EXPECT_DOUBLE_EQ(last_sensitivity, 2.0);
+  EXPECT_NEAR(y[0], std::exp(-2.0), 1e-5);
+}
+
 // IDAS evaluates the state's residual at each step's converged state for the sensitivity
 // residual's `residual` argument: evaluated where the problem reads it, skipped where it does
 // not, with the same steps and the same numbers either way.
