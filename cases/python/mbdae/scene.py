@@ -2,6 +2,7 @@
 import json
 import math
 import os
+import reprlib
 import shutil
 import tempfile
 import weakref
@@ -135,8 +136,9 @@ class Scene:
         of names; default every output sensor, E then relative to each one's scale) is at most E
         (summary["error_target"]; status "accuracy_not_met" when it cannot); error_warnings=False
         keeps the estimate's warnings (over 10 rtol) off stderr. `sensitivities` (a parameter path
-        or a list of them, as `set` takes them) also integrates d(sensor)/d(parameter) of every
-        output sensor (Result.sensitivities, docs/sensitivities.md). Returns a Result; a failed
+        as a str, or a list or tuple of them, as `set` takes them; other types are a TypeError)
+        also integrates d(sensor)/d(parameter) of every output sensor (Result.sensitivities,
+        docs/sensitivities.md). Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis, sensitivities)
@@ -243,16 +245,28 @@ def _rebuild(path, text, overrides):
 
 
 def _paths(name, value):
-    """A parameter path or a list of them, as strings (ValueError otherwise)."""
+    """Parameter paths for option `name`: one path (a str) or a list or tuple of them. Anything else
+    (a dict, a set, bytes, an iterator) is a TypeError, not read as its keys, in some order or
+    byte by byte; an empty path or one that UTF-8 cannot encode (a lone surrogate) is a ValueError."""
     items = [value] if isinstance(value, str) else value
-    try:
-        items = list(items)
-    except TypeError:
-        raise ValueError(f"{name} expects a parameter path or a list of them, got {value!r}") from None
+    if not isinstance(items, (list, tuple)):
+        raise TypeError(f"{name} expects a parameter path or a list of them (a str, or a list or tuple of str), "
+                        f"got {_given(value)}")
     for p in items:
-        if not isinstance(p, str) or not p:
+        if not isinstance(p, str):
+            raise TypeError(f"{name} expects parameter paths (non-empty strings), got {_given(p)} in {_given(value)}")
+        if not p:
             raise ValueError(f"{name} expects parameter paths (non-empty strings), got {p!r}")
-    return items
+        try:
+            p.encode("utf-8")
+        except UnicodeEncodeError as e:
+            raise ValueError(f"{name}: the path {p!r} cannot be encoded as UTF-8 ({e.reason})") from None
+    return list(items)
+
+
+def _given(value):
+    """What a caller passed, for a message: its type and a shortened repr ("bytes b'gravity.2'")."""
+    return f"{type(value).__name__} {reprlib.repr(value)}"
 
 
 def _number(name, value):

@@ -111,9 +111,9 @@ def test_nan_load_is_a_solve_error_naming_the_load(tmp_path):
 
 # Issue 24: sensitivities asked from Python get the CLI's checks before anything runs.
 @pytest.mark.parametrize("value, words", [
-    (5, "expects a parameter path or a list of them"),
     ([""], "non-empty strings"),
-    ([3.0], "non-empty strings"),
+    (["gravity.2", "bodies.wheel.\udcff"], "sensitivities: the path 'bodies.wheel."),
+    ("\udcff", "cannot be encoded as UTF-8"),
     (["forces.motr.torque"], "no such parameter"),
     (["bodies.wheel.mas"], "did you mean 'bodies.wheel.mass'"),
     (["gravity"], "not a single number; name one element: gravity.0"),
@@ -124,6 +124,30 @@ def test_bad_sensitivity_requests_are_refused(value, words, tmp_path):
     with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(".", r"\.")):
         wheel().run(sensitivities=value, out=tmp_path / "out")
     assert not (tmp_path / "out" / "summary.json").exists()
+
+
+# A list or tuple of str, or one path as a str; any other type is a TypeError naming the argument
+# and what was given (a dict was read as its keys, a set in its own order, bytes byte by byte).
+@pytest.mark.parametrize("value, given", [
+    (5, "got int 5"),
+    ([3.0], "got float 3.0 in list [3.0]"),
+    ({"gravity.2": 1}, "got dict {'gravity.2': 1}"),
+    ({"gravity.2"}, "got set {'gravity.2'}"),
+    (b"gravity.2", "got bytes b'gravity.2'"),
+    (["gravity.2", b"gravity.1"], "got bytes b'gravity.1' in list"),
+    (iter(["gravity.2"]), "got list_iterator"),
+])
+def test_sensitivities_of_another_type_are_a_type_error(value, given, tmp_path):
+    with pytest.raises(TypeError) as e:
+        wheel().run(sensitivities=value, out=tmp_path / "out")
+    assert str(e.value).startswith("sensitivities expects") and given in str(e.value), str(e.value)
+    assert not (tmp_path / "out" / "summary.json").exists()
+
+
+def test_sensitivities_as_one_str_a_list_or_a_tuple_are_alike():
+    runs = [wheel().run(sensitivities=v).sensitivities for v in ("gravity.1", ["gravity.1"], ("gravity.1",))]
+    assert list(runs[0].columns) == [("angle", "gravity.1")]
+    assert runs[0].equals(runs[1]) and runs[0].equals(runs[2])
 
 
 def test_sensitivities_not_with_index3_by_name():
