@@ -102,8 +102,9 @@ struct Result {
 // The sensitivities relative to the parameters' values and the sensors' scales,
 // (p / max|y|) dy/dp, max|y| each sensor's largest magnitude over the run (a pointwise (p / y)
 // dy/dp is unbounded where y crosses zero): "t", then "d(SENSOR)/d(PATH)*p/max|SENSOR|" for each
-// column of Result::sensitivities whose sensor is not zero throughout (column-major). Empty
-// without sensitivities.
+// column of Result::sensitivities whose sensor is not zero throughout (column-major); a run
+// without samples (static steps only) keeps every column, with no rows. Empty without
+// sensitivities.
 struct NormalizedSensitivities {
   std::vector<std::string> columns;
   std::vector<std::vector<double>> data;

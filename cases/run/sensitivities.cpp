@@ -338,7 +338,9 @@ NormalizedSensitivities normalized_sensitivities(const Result& r) {
   for (size_t k = 1; k < r.columns.size(); ++k) {
     double scale = 0;
     for (double y : r.data[k]) scale = std::fmax(scale, std::fabs(y));
-    if (!(scale > 0)) continue;
+    // A sensor zero throughout has no scale; without samples (static steps only) every column is
+    // kept, empty, so the file has sensitivities.csv's columns rather than `t` alone.
+    if (!(scale > 0) && r.rows() > 0) continue;
     for (size_t i = 0; i < np; ++i) {
       const size_t col = 1 + (k - 1) * np + i;
       const double f = params[i]["value"].get<double>() / scale;

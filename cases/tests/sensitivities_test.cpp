@@ -232,5 +232,25 @@ TEST_F(SensitivitiesCli, WritesTheCsvAndListsTheParametersInTheSummary) {
   }
 }
 
+// A scene of static steps only has no samples: sensitivities.csv and sensitivities_normalized.csv
+// are header lines with every column (no sensor is dropped for a scale it cannot have), and the
+// step's sensitivities are in summary.json.
+TEST_F(SensitivitiesCli, StaticStepsOnlyWriteEveryColumnAndNoRows) {
+  std::string text = oscillator("index3");
+  text.erase(text.find("  - {type: dynamics"));
+  {
+    std::ofstream(dir / "s.yaml") << text;
+  }
+  const auto r = run_command(std::string(MBDAE_EXE) + " run " + (dir / "s.yaml").string() + " --out " + out.string() +
+                             " --quiet --sensitivity bodies.slider.mass --normalized-sensitivities");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(read_file(out / "sensitivities.csv"), "t,d(z)/d(bodies.slider.mass),d(vz)/d(bodies.slider.mass)\n");
+  EXPECT_EQ(read_file(out / "sensitivities_normalized.csv"),
+            "t,d(z)/d(bodies.slider.mass)*p/max|z|,d(vz)/d(bodies.slider.mass)*p/max|vz|\n");
+  const auto summary = nlohmann::json::parse(read_file(out / "summary.json"));
+  EXPECT_EQ(summary["sensitivities"]["rows"], 0);
+  EXPECT_TRUE(summary["steps"][0]["sensitivities"].contains("z")) << summary["steps"][0].dump();
+}
+
 }  // namespace
 }  // namespace mbdae

@@ -87,12 +87,16 @@ class Result:
         """The sensitivities relative to the parameters' values and the sensors' scales:
         (p / max|y|) dy/dp, max|y| each sensor's largest magnitude over the run (a pointwise
         (p / y) dy/dp is unbounded where y crosses zero). A DataFrame like `sensitivities`; a
-        sensor that is zero throughout gets no column. None without sensitivities. The rule of
+        sensor that is zero throughout gets no column, a run without samples (static steps only,
+        their sensitivities in summary["steps"]) every column and no rows. None without
+        sensitivities. The rule of
         the CLI's sensitivities_normalized.csv (cases/run/sensitivities.cpp), kept alike by
         test_api.py::test_normalized_sensitivities_are_the_clis."""
         table = self.sensitivities
         if table is None:
             return None
+        if not self.rows:  # no samples, no scales: every column, empty (as the CLI's file)
+            return table.copy()
         values = {p["path"]: p["value"] for p in self.summary["sensitivities"]["parameters"]}
         keep = [c for c in table.columns if np.abs(self[c[0]]).max() > 0]
         scale = np.array([values[p] / np.abs(self[s]).max() for s, p in keep])

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import mbdae
-from conftest import PAST_TRAVEL, STEP, cli_run, csv_text, needs_analysis_option, needs_overrides, same_columns
+from conftest import PAST_TRAVEL, STEP, SUSPENSION, cli_run, csv_text, needs_analysis_option, needs_overrides, same_columns
 
 ROOT_ERRORS = STEP.parents[2] / "verification" / "engine" / "scenes"
 
@@ -271,3 +271,24 @@ def test_normalized_sensitivities_are_the_clis(tmp_path):
         assert column == f"d({sensor})/d({param})*p/max|{sensor}|", column
         x, y = table[(sensor, param)].to_numpy(), csv[column].to_numpy()
         assert np.allclose(x, y, rtol=1e-9, atol=1e-12 * np.abs(y).max()), column
+
+
+def test_static_steps_only_have_empty_sensitivity_tables_as_the_cli(tmp_path):
+    """A scene of static steps only has no samples: Result.sensitivities and
+    normalized_sensitivities() have every (sensor, parameter) column and no rows, as the CLI's
+    sensitivities.csv and sensitivities_normalized.csv (header lines); the step's sensitivities
+    are in the summary."""
+    import pandas as pd
+    scene, path = SUSPENSION / "equilibrium.yaml", "forces.suspension.stiffness"
+    code, err = cli_run(scene, tmp_path, "--sensitivity", path, "--normalized-sensitivities")
+    assert code == 0, err
+    r = mbdae.load(scene).run(sensitivities=[path])
+    assert r.rows == 0 and r.sensitivities.shape == (0, len(r.names) - 1)
+    norm = r.normalized_sensitivities()
+    assert norm.shape == (0, len(r.names) - 1) and list(norm.columns) == list(r.sensitivities.columns)
+    assert norm.index.name == "t"
+    csv = pd.read_csv(tmp_path / "sensitivities_normalized.csv")
+    assert len(csv) == 0
+    assert list(csv.columns[1:]) == [f"d({s})/d({p})*p/max|{s}|" for s, p in norm.columns]
+    assert len(pd.read_csv(tmp_path / "sensitivities.csv").columns) == len(csv.columns)
+    assert "wheel_z" in r.summary["steps"][-1]["sensitivities"]
