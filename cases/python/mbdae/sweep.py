@@ -7,6 +7,7 @@ Dask) and writes every file; each task applies its overrides to the scene, runs 
 the metrics and returns its row and its columns. See docs/python.md."""
 import asyncio
 import itertools
+import json
 import os
 import socket
 import sys
@@ -21,7 +22,8 @@ from .errors import SceneError
 from .sweep_backends import backend
 from .sweep_checks import (RUN_OPTIONS, check_metrics, check_options, check_parameters, check_workers,
                            metric_fingerprint, plain, run_key, scene_key)
-from .sweep_files import (FolderLock, SweepOutputError, finished_row, read_h5, read_json, record, write_json)
+from .sweep_files import (FolderLock, SweepOutputError, finished_row, read_h5, read_h5_sensitivities, read_json,
+                          record, write_json)
 from .sweep_table import make_table, read_run, read_sweep, runs_dataset  # noqa: F401 -- re-exported
 
 __all__ = ["sweep", "expand", "run_one", "read_run", "read_sweep", "runs_dataset", "RUN_OPTIONS",
@@ -60,7 +62,8 @@ def compute_metrics(result, metrics, row):
 
 def run_one(scene, run, options, metrics):
     """The task: one run with its overrides and options; never raises for a bad or failing run
-    (the row says what happened). Returns {"row", "columns": {name: array}, "units", "summary"}."""
+    (the row says what happened). Returns {"row", "columns": {name: array}, "units", "summary",
+    "sensitivities": None or {"columns": {name: array}, "units"}}."""
     cpu0, wall0 = time.thread_time(), time.perf_counter()
     row = {"status": "", "message": "", "worker": f"{socket.gethostname()}:{os.getpid()}"}
     overrides = [(k, v) for k, v in run.items() if k not in RUN_OPTIONS]
@@ -79,37 +82,74 @@ def run_one(scene, run, options, metrics):
     row["cpu_s"] = time.thread_time() - cpu0
     row["wall_s"] = time.perf_counter() - wall0
     if result is None:
-        return {"row": row, "columns": None, "units": None, "summary": None}
+        return {"row": row, "columns": None, "units": None, "summary": None, "sensitivities": None}
     return {"row": row, "columns": {n: np.array(a) for n, a in result.columns.items()}, "units": list(result.units),
-            "summary": result._summary_json}
+            "summary": result._summary_json, "sensitivities": _sensitivity_payload(result)}
+
+
+def _sensitivity_payload(result):
+    """The run's sensitivities for its file ({"columns": {name: array}, "units"}), or None."""
+    if not result._sens_names:
+        return None
+    return {"columns": {n: np.array(a) for n, a in zip(result._sens_names, result._sens_arrays)},
+            "units": list(result._sens_units)}
 
 
 def _stored_result(out, row):
-    """A Result rebuilt from a run's stored file (to compute changed metrics without running)."""
+    """A Result rebuilt from a run's stored file (to compute changed metrics without running),
+    with its sensitivities; None if the run asked for sensitivities its file does not hold (a
+    file of an earlier version): the run is then computed again."""
     from .result import Result
     df, _, summary = read_h5(out / row["file"])
     units = df.attrs.get("units", {})
     names = [df.index.name or "t", *df.columns]
     arrays = [df.index.to_numpy(), *(df[c].to_numpy() for c in df.columns)]
-    import json
+    sens = read_h5_sensitivities(out / row["file"])
+    if sens is None and "sensitivities" in summary:
+        return None
+    sensitivity = ((), (), ()) if sens is None else (
+        ["t", *sens.columns], [sens.attrs["units"].get(n, "") for n in ["t", *sens.columns]],
+        [sens.index.to_numpy(), *(sens[c].to_numpy() for c in sens.columns)])
     return Result(row.get("run_status", row["status"]), row.get("run_message", ""), names, arrays,
-                  [units.get(n, "") for n in names], json.dumps(summary))
+                  [units.get(n, "") for n in names], json.dumps(summary), sensitivity=sensitivity)
 
 
 def _refresh_metrics(out, row, metrics, defs):
     """A reused run whose metrics were defined otherwise: recomputed from its stored samples and
-    its row rewritten (never returned stale)."""
+    its row rewritten (never returned stale). None when the stored run cannot give its metrics
+    what the run gave them (its sensitivities): it is run again."""
     if row.get("metric_defs") == defs:
         return row
+    stored = _stored_result(out, row) if row.get("file") else None
+    if row.get("file") and stored is None:
+        return None
     for name in set(row.get("metric_defs") or {}) - set(defs):
         row.pop(name, None)
-    if row.get("file"):
-        compute_metrics(_stored_result(out, row), metrics, row)
+    if stored is not None:
+        compute_metrics(stored, metrics, row)
     else:
         row.update({name: float("nan") for name in metrics})
     row["metric_defs"] = defs
     write_json(out / "runs" / f"{row['key']}.json", row)
     return row
+
+
+def _reused_rows(out, manifest, metrics, defs):
+    """({key: row} of the folder's finished runs, with their metrics brought up to date, and how
+    many broken runs were removed); the others run again."""
+    rows, broken = {}, 0
+    for i, e in enumerate(manifest["runs"]):
+        row, problem = finished_row(out, e["key"])
+        if row is not None:
+            row = _refresh_metrics(out, row, metrics, defs)
+            problem = "" if row is not None else "its file holds no sensitivities for the changed metrics"
+        else:
+            broken += bool(problem)
+        if row is not None:
+            rows[e["key"]] = row
+        elif problem:
+            print(f"mbdae sweep: run {i}: {problem}; it runs again", file=sys.stderr)
+    return rows, broken
 
 
 def _manifest(out, scene, runs, keys, options, defs, extend):
@@ -229,14 +269,7 @@ def _sweep_locked(scene, runs, out, client, metrics, options, workers, progress,
     defs = {n: metric_fingerprint(f) for n, f in metrics.items()}
     try:
         manifest = _manifest(out, scene, runs, keys, options, defs, extend)
-        rows, broken = {}, 0
-        for i, e in enumerate(manifest["runs"]):
-            row, problem = finished_row(out, e["key"])
-            if row is not None:
-                rows[e["key"]] = _refresh_metrics(out, row, metrics, defs)
-            elif problem:
-                broken += 1
-                print(f"mbdae sweep: run {i}: {problem}; it runs again", file=sys.stderr)
+        rows, broken = _reused_rows(out, manifest, metrics, defs)
     except OSError as e:
         raise SweepOutputError(e.errno, f"{out}: cannot write the sweep's files: {e.strerror or e}; nothing "
                                f"was run") from None

@@ -2,7 +2,8 @@
 
     OUT/.mbdae.lock        the folder's lock (flock, the CLI's own: one sweep or run at a time)
     OUT/sweep.json         what the sweep is: its runs (keys, parameters), options, metrics, units
-    OUT/runs/KEY.h5        a run's samples (t as index, units and summary as attributes)
+    OUT/runs/KEY.h5        a run's samples (t as index, units and summary as attributes) and,
+                           asked for, its sensitivities (key "sensitivities", the same form)
     OUT/runs/KEY.json      its row, written last: the mark of a finished run, with the .h5's
                            SHA-256 and row count, checked before the run is reused
     OUT/runs.csv           the table
@@ -84,19 +85,30 @@ def read_json(path):
         return None
 
 
-def h5_image(columns, units, params, summary):
-    """A run's samples as the bytes of an HDF5 file (pandas.read_hdf): `t` as the index, the other
-    columns as columns; units ({column: unit}), parameters and summary.json as attributes."""
+def _frame(columns):
+    """{name: array} as a DataFrame with the first column as its index."""
     import pandas as pd
     names = list(columns)
     index = pd.Index(np.asarray(columns[names[0]]), name=names[0])
-    df = pd.DataFrame({n: np.asarray(columns[n]) for n in names[1:]}, index=index)
+    return pd.DataFrame({n: np.asarray(columns[n]) for n in names[1:]}, index=index)
+
+
+def h5_image(columns, units, params, summary, sensitivities=None):
+    """A run's samples as the bytes of an HDF5 file (pandas.read_hdf): `t` as the index, the other
+    columns as columns; units ({column: unit}), parameters and summary.json as attributes. With
+    `sensitivities` ({"columns": {name: array}, "units": [...]}, "t" first) they are stored under
+    the key "sensitivities" the same way, so a reused run hands them to its metrics again."""
+    import pandas as pd
     with pd.HDFStore("mbdae-run-in-memory.h5", mode="w", driver="H5FD_CORE", driver_core_backing_store=0) as store:
-        store.put("results", df, format="fixed")
+        store.put("results", _frame(columns), format="fixed")
         attrs = store.get_storer("results").attrs
-        attrs.units = json.dumps(dict(zip(names, units)))
+        attrs.units = json.dumps(dict(zip(columns, units)))
         attrs.params = json.dumps(params, default=str)
         attrs.summary = summary or "{}"
+        if sensitivities:
+            store.put("sensitivities", _frame(sensitivities["columns"]), format="fixed")
+            store.get_storer("sensitivities").attrs.units = json.dumps(
+                dict(zip(sensitivities["columns"], sensitivities["units"])))
         store._handle.flush()
         return store._handle.get_file_image()
 
@@ -120,12 +132,24 @@ def read_h5(path):
         return df, json.loads(attrs.params), json.loads(attrs.summary)
 
 
+def read_h5_sensitivities(path):
+    """The sensitivities of a run file (t as index, columns d(SENSOR)/d(PATH), units in
+    attrs["units"]), or None if the run stored none."""
+    import pandas as pd
+    with pd.HDFStore(path, mode="r") as store:
+        if "/sensitivities" not in store.keys():
+            return None
+        df = store["sensitivities"]
+        df.attrs["units"] = json.loads(store.get_storer("sensitivities").attrs.units)
+        return df
+
+
 def record(out, index, key, run, payload, metric_defs):
     """Writes a run's .h5 (if it has samples) then its row (.json); returns the row."""
     row = {"run": index, **{k: plain(v) for k, v in run.items()}, **payload["row"], "key": key, "file": ""}
     if payload.get("columns"):
         image = h5_image(payload["columns"], payload.get("units") or [""] * len(payload["columns"]),
-                         {k: plain(v) for k, v in run.items()}, payload.get("summary"))
+                         {k: plain(v) for k, v in run.items()}, payload.get("summary"), payload.get("sensitivities"))
         name = Path("runs") / f"{key}.h5"
         write_bytes(out / name, image)
         row.update(file=str(name), file_sha256=hashlib.sha256(image).hexdigest())

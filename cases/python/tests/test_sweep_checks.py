@@ -19,7 +19,7 @@ import mbdae
 from conftest import ROOT, STEP
 from mbdae import metrics as M
 from mbdae.sweep import expand
-from mbdae.sweep_files import read_h5
+from mbdae.sweep_files import read_h5, read_h5_sensitivities
 
 
 def short_scene():
@@ -88,6 +88,43 @@ def test_changed_metrics_on_resume_are_recomputed_from_the_stored_runs(tmp_path)
                         metrics={"m": M.peak("wheel_z"), "k": lambda r: scale * r["wheel_z"][-1]})
     assert np.allclose(third["k"], 1.5 * again["k"], rtol=1e-15) and third.attrs["skipped"] == 3
     assert list(pd.read_csv(tmp_path / "runs.csv")["k"]) == list(third["k"])
+
+
+TYRE = "forces.tyre.stiffness"
+
+
+def test_resumed_runs_keep_their_sensitivities_for_changed_metrics(tmp_path):
+    """A reused run is rebuilt from its file with its sensitivities (stored under the key
+    "sensitivities"), so a changed metric that reads them gets the run's values, not None."""
+    scene, grid = short_scene(), {"forces.suspension.damping": [700.0, 2800.0]}
+    peak = {"p": lambda r: r.sensitivities[("wheel_z", TYRE)].abs().max()}
+    first = mbdae.sweep(scene, grid, out=tmp_path, options={"sensitivities": [TYRE]}, metrics=peak, progress=False)
+    last = {"p": lambda r: r.sensitivities[("wheel_vz", TYRE)].iloc[-1]}
+    again = mbdae.sweep(scene, grid, out=tmp_path, options={"sensitivities": [TYRE]}, metrics=last, progress=False)
+    assert again.attrs["skipped"] == 2 and list(again["status"]) == ["ok", "ok"], again["message"].tolist()
+    for i, run in enumerate(expand(grid)):
+        alone = scene.with_params(run).run(sensitivities=[TYRE]).sensitivities
+        assert first["p"][i] == alone[("wheel_z", TYRE)].abs().max()
+        assert again["p"][i] == alone[("wheel_vz", TYRE)].iloc[-1]
+        stored = read_h5_sensitivities(tmp_path / again["file"][i])
+        assert np.array_equal(stored.to_numpy(), alone.to_numpy())
+        assert stored.attrs["units"][f"d(wheel_z)/d({TYRE})"] == "m/(N/m)"
+
+
+def test_a_stored_run_without_its_sensitivities_runs_again(tmp_path, monkeypatch, capsys):
+    """A run file that lacks the sensitivities its run asked for (written before they were
+    stored) is not handed to a changed metric without them: the run is computed again."""
+    scene, grid = short_scene(), {"forces.suspension.damping": [1400.0]}
+    monkeypatch.setattr(sys.modules["mbdae.sweep"], "_sensitivity_payload", lambda result: None)
+    mbdae.sweep(scene, grid, out=tmp_path, options={"sensitivities": [TYRE]}, progress=False)
+    monkeypatch.undo()
+    assert read_h5_sensitivities(next((tmp_path / "runs").glob("*.h5"))) is None
+    capsys.readouterr()
+    metric = {"p": lambda r: r.sensitivities[("wheel_z", TYRE)].abs().max()}
+    table = mbdae.sweep(scene, grid, out=tmp_path, options={"sensitivities": [TYRE]}, metrics=metric, progress=False)
+    assert table.attrs["skipped"] == 0 and list(table["status"]) == ["ok"], table["message"].tolist()
+    assert "run 0: its file holds no sensitivities for the changed metrics; it runs again" in capsys.readouterr().err
+    assert read_h5_sensitivities(tmp_path / table["file"][0]) is not None
 
 
 def test_units_and_t_index_in_the_sweep_files(tmp_path):
