@@ -20,8 +20,8 @@ import numpy as np
 from . import metrics as _metrics
 from .errors import SceneError
 from .sweep_backends import backend
-from .sweep_checks import (RUN_OPTIONS, check_metrics, check_options, check_parameters, check_workers,
-                           metric_fingerprint, plain, run_key, scene_key)
+from .sweep_checks import (RUN_OPTIONS, check_metrics, check_options, check_parameters, check_sensitivities,
+                           check_workers, metric_fingerprint, plain, run_key, scene_key)
 from .sweep_files import (FolderLock, SweepOutputError, finished_row, read_h5, read_h5_sensitivities, read_json,
                           record, write_json)
 from .sweep_table import make_table, read_run, read_sweep, runs_dataset  # noqa: F401 -- re-exported
@@ -249,8 +249,7 @@ def sweep(scene, params, out, client=None, metrics=None, options=None, workers=N
         raise ValueError(f"worker_timeout expects seconds > 0, got {worker_timeout!r}")
     check_parameters(scene, runs)
     check_metrics(scene, metrics)
-    if "sensitivities" in options:  # the paths against the scene, before the first run
-        scene.run_options(sensitivities=options["sensitivities"], formulation=options.get("formulation"))
+    check_sensitivities(scene, runs, options)
     out = Path(out)
     try:
         (out / "runs").mkdir(parents=True, exist_ok=True)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._core import formulations
 from .errors import SceneError
 
 # Sweep keys that are run options (as scene.run's arguments), not scene parameter paths.
@@ -65,6 +66,35 @@ def check_options(options):
     if unknown:
         raise ValueError(f"options: unknown run option '{unknown[0]}'{suggestion(unknown[0], RUN_OPTIONS)} "
                          f"(run options: {', '.join(RUN_OPTIONS)})")
+
+
+def check_sensitivities(scene, runs, options):
+    """The sensitivities of `options` and of every run whose grid entry sets `sensitivities` or
+    `formulation`, checked as scene.run checks them (with the run's formulation: index3 refuses
+    them) before the first run: a bad type is a TypeError, a bad path or combination a ValueError,
+    naming the grid entry. A formulation that is no registered one is left to its run (an
+    `invalid` row, as any bad value)."""
+    if "sensitivities" in options:
+        scene.run_options(sensitivities=options["sensitivities"], formulation=_known(options.get("formulation")))
+    seen = set()
+    for i, run in enumerate(runs):
+        if "sensitivities" not in run and "formulation" not in run:
+            continue
+        merged = {**options, **{k: plain(v) for k, v in run.items() if k in ("sensitivities", "formulation")}}
+        asked = {k: merged[k] for k in ("sensitivities", "formulation") if k in merged}
+        if asked.get("sensitivities") is None or repr(asked) in seen:
+            continue
+        seen.add(repr(asked))
+        try:
+            scene.run_options(sensitivities=asked["sensitivities"], formulation=_known(asked.get("formulation")))
+        except (TypeError, ValueError) as e:
+            given = ", ".join(f"{k}={v!r}" for k, v in asked.items())
+            raise type(e)(f"params: run {i} ({given}): {e}") from None
+
+
+def _known(formulation):
+    """`formulation` if it is a registered one, else None (its run refuses it)."""
+    return formulation if isinstance(formulation, str) and formulation in formulations() else None
 
 
 def check_metrics(scene, metrics):

@@ -127,6 +127,36 @@ def test_a_stored_run_without_its_sensitivities_runs_again(tmp_path, monkeypatch
     assert read_h5_sensitivities(tmp_path / table["file"][0]) is not None
 
 
+@pytest.mark.parametrize("params, options, error, words", [
+    ({"sensitivities": [TYRE, "bodies.wheel.mas"]}, {}, ValueError,
+     "params: run 1 (sensitivities='bodies.wheel.mas'): sensitivities 'bodies.wheel.mas': no such parameter"),
+    ({"formulation": ["index2-ggl", "index3"]}, {"sensitivities": [TYRE]}, ValueError,
+     "params: run 1 (sensitivities=['forces.tyre.stiffness'], formulation='index3'): sensitivities: not with "
+     "formulation index3"),
+    ([{"sensitivities": [TYRE], "formulation": "index3"}], {}, ValueError, "params: run 0 ("),
+    ([{"rtol": 1e-6}, {"sensitivities": {TYRE}}], {}, TypeError,
+     "params: run 1 (sensitivities={'forces.tyre.stiffness'}): sensitivities expects a parameter path"),
+    (GRID, {"sensitivities": b"gravity.2"}, TypeError, "sensitivities expects a parameter path"),
+    (GRID, {"sensitivities": [TYRE], "formulation": "index3"}, ValueError, "sensitivities: not with formulation"),
+])
+def test_sensitivities_of_every_run_are_checked_before_the_first_run(tmp_path, params, options, error, words):
+    """The grid's own sensitivities, and the options' with a grid formulation, are checked as the
+    options' are: before anything runs, naming the grid entry (they were `invalid` rows)."""
+    with pytest.raises(error) as e:
+        mbdae.sweep(short_scene(), params, out=tmp_path, options=options, progress=False)
+    assert str(e.value).startswith(words), str(e.value)
+    assert no_runs_started(tmp_path)
+
+
+def test_grid_sensitivities_run_per_entry_and_a_bad_formulation_stays_an_invalid_row(tmp_path):
+    grid = {"sensitivities": [TYRE, [TYRE, "forces.suspension.damping"]], "formulation": ["index1", "index7"]}
+    table = mbdae.sweep(short_scene(), grid, out=tmp_path, progress=False,
+                        metrics={"n": lambda r: len(r.sensitivities.columns)})
+    assert list(table["status"]) == ["ok", "invalid", "ok", "invalid"], table["message"].tolist()
+    assert "got 'index7'" in table["message"][1]
+    assert table["n"][2] == 2 * table["n"][0] > 0
+
+
 def test_units_and_t_index_in_the_sweep_files(tmp_path):
     scene = short_scene()
     table = mbdae.sweep(scene, GRID, out=tmp_path, metrics={"travel": M.peak_deviation("wheel_z"),
