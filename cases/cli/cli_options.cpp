@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 
 #include "cases/scene/analysis_types.h"
 #include "cases/scene/field_ranges.h"
@@ -18,10 +19,32 @@ std::string read_number(const std::string& option, const std::string& text, doub
   return why.empty() ? "" : option + ": " + why;
 }
 
+// What an option that takes a value expects, or nullptr for the others: the word after it is not
+// taken as its value when it is itself an option (`--sensitivity --out d` took `--out` as the
+// path, then refused `d` as an unknown argument).
+const char* expected_value(const std::string& option) {
+  static const std::pair<const char*, const char*> kinds[] = {
+      {"--out", "a folder"},
+      {"--rtol", "a number"},
+      {"--atol", "a number"},
+      {"--output-step", "a number"},
+      {"--formulation", "a formulation"},
+      {"--error-target", "a number"},
+      {"--error-sensors", "sensor names separated by commas"},
+      {"--sensitivity", "a parameter path"},
+      {"--animation-rate", "a number"},
+  };
+  for (const auto& [name, kind] : kinds)
+    if (option == name) return kind;
+  return nullptr;
+}
+
 std::string read_option(const std::vector<std::string>& args, size_t& i, CommandLine& cl) {
   const std::string& a = args[i];
   RunOptions& opt = cl.options;
   const bool has_value = i + 1 < args.size();
+  if (const char* kind = expected_value(a); kind && has_value && args[i + 1].rfind("--", 0) == 0)
+    return a + ": expects " + kind + ", got '" + args[i + 1] + "'";
   if (a == "--out" && has_value) {
     cl.out_dir = args[++i];
     return cl.out_dir.empty() ? "--out: expected a folder, got ''" : "";

@@ -781,6 +781,28 @@ TEST_F(Executable, AssemblyModeWarningOnStderrAlsoWhenQuiet) {
   EXPECT_NE(r.output.find("mbdae: warning: assembly converged far from the guess"), std::string::npos) << r.output;
 }
 
+// An option's value that is itself an option is refused, naming what the option expects (the
+// next word was taken as the value and the one after it refused as an unknown argument).
+TEST_F(Executable, OptionValueThatIsAnOptionIsRefused) {
+  const std::string scene = "run '" + write(kValid) + "'";
+  const std::pair<std::string, std::string> cases[] = {
+      {" --sensitivity --out d", "mbdae: --sensitivity: expects a parameter path, got '--out'"},
+      {" --out --rtol 1e-6", "mbdae: --out: expects a folder, got '--rtol'"},
+      {" --out d --rtol --quiet", "mbdae: --rtol: expects a number, got '--quiet'"},
+      {" --out d --formulation --quiet", "mbdae: --formulation: expects a formulation, got '--quiet'"},
+      {" --out d --error-target 1e-6 --error-sensors --quiet",
+       "mbdae: --error-sensors: expects sensor names separated by commas, got '--quiet'"},
+      {" --out d --animation-rate --quiet", "mbdae: --animation-rate: expects a number, got '--quiet'"},
+  };
+  for (const auto& [args, message] : cases) {
+    const CliResult r = run(scene + args);
+    EXPECT_EQ(r.code, 1) << args << "\n" << r.output;
+    EXPECT_EQ(r.output.substr(0, r.output.find('\n')), message) << args << "\n" << r.output;
+  }
+  const CliResult negative = run(scene + " --out '" + (dir / "out").string() + "' --quiet --rtol -1e-6");
+  EXPECT_NE(negative.output.find("mbdae: --rtol: out of range"), std::string::npos) << negative.output;
+}
+
 TEST_F(Executable, UsageErrorExitsOne) {
   EXPECT_EQ(run("").code, 1);
   EXPECT_EQ(run("run '" + write(kValid) + "'").code, 1);  // no --out
