@@ -8,8 +8,12 @@
 namespace mbdae {
 
 TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base,
-                                     std::vector<ParameterTwins> twins, bool in_error_test)
+                                     std::vector<ParameterTwins> twins, bool in_error_test, bool difference_first)
     : run_(run), base_(std::move(base)), twins_(std::move(twins)), in_error_test_(in_error_test) {
+  if (!difference_first) {  // A0 to the end, as after kMaxFailures failures of the difference
+    exact_ = true;
+    failures_ = kMaxFailures;
+  }
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
   a0_.resize(base_->jacobian_pattern().nnz());

@@ -41,8 +41,10 @@ class TwinSensitivities : public SensitivityProblem {
  public:
   // `run` is the formulation being integrated; the twins must have its size.
   // `base` is another copy of the run's formulation on the run's own model (its Newton matrix).
+  // `difference_first`: F_y s + F_p by the one difference of the twins until it fails (then A0
+  // after every start, below); else (the run's choice) A0 s + F_p from the start.
   TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base, std::vector<ParameterTwins> twins,
-                    bool in_error_test);
+                    bool in_error_test, bool difference_first = false);
 
   int count() const override { return static_cast<int>(twins_.size()); }
   double scale(int i) const override { return twins_[i].scale; }

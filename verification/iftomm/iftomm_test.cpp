@@ -566,4 +566,52 @@ TEST(A05StiffFlyballGovernor, SleeveMotionAndAngularMomentum) {
   EXPECT_LT(rise, 1e-6);  // the dampers only take energy out
 }
 
+// Sensitivities of the governor, one parameter per run, against central differences of rtol
+// 1e-12 runs (steps stated per parameter) over the 10 s: the initial shaft speed, a spring's
+// free length, a ball's mass. Before 2026-11-27 (night) F_y s came from one central difference
+// of the twins along s, whose truncation on these stiff springs (d^2 times the third
+// derivative, growing with |d s|) put them up to 1.8e-1 off, with status ok; they now use the
+// assembled F_y (docs/sensitivities.md, Method).
+TEST(A05StiffFlyballGovernor, SensitivitiesMatchCentralDifferences) {
+  const mbdae::Scene scene = mbdae::load_scene(scene_path("A05_stiff_flyball_governor.yaml"));
+  const struct {
+    const char* path;
+    double value, h;
+  } params[] = {{"analysis.dynamics.initial_velocities.phi", 2 * kPi, 6e-4},
+                {"forces.springA.free_length", 0.5, 1e-5},
+                {"bodies.ballA.mass", 5.0, 1e-4}};
+  for (const auto& p : params) {
+    mbdae::RunOptions o;
+    o.verbose = o.progress = o.report_failures = false;
+    o.sensitivities = {p.path};
+    const mbdae::Result r = mbdae::run(scene, o);
+    ASSERT_TRUE(r.ok()) << p.path << ": " << r.message;
+    mbdae::RunOptions tight;
+    tight.verbose = tight.progress = false;
+    tight.rtol = 1e-12;
+    auto text = [](double v) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", v);
+      return std::string(buf);
+    };
+    const mbdae::Result plus = mbdae::run(mbdae::with_parameters(scene, {{p.path, text(p.value + p.h)}}), tight);
+    const mbdae::Result minus = mbdae::run(mbdae::with_parameters(scene, {{p.path, text(p.value - p.h)}}), tight);
+    ASSERT_TRUE(plus.ok() && minus.ok());
+    for (const char* sensor : {"s", "omega", "bA"}) {
+      const std::string name = std::string("d(") + sensor + ")/d(" + p.path + ")";
+      const auto k = std::find(r.sensitivity_columns.begin(), r.sensitivity_columns.end(), name) - r.sensitivity_columns.begin();
+      ASSERT_LT(k, static_cast<long>(r.sensitivity_columns.size())) << name;
+      const auto &a = plus.column(sensor), &b = minus.column(sensor), &sens = r.sensitivities[k];
+      double worst = 0, scale = 0;
+      for (size_t i = 0; i < sens.size() && i < a.size(); ++i) {
+        const double fd = (a[i] - b[i]) / (2 * p.h);
+        worst = std::max(worst, std::fabs(sens[i] - fd));
+        scale = std::max(scale, std::fabs(fd));
+      }
+      std::printf("measured: A05 d(%s)/d(%s): %.2e of the largest\n", sensor, p.path, worst / scale);
+      EXPECT_LT(worst / scale, 1e-4) << name;
+    }
+  }
+}
+
 }  // namespace
