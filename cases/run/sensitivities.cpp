@@ -363,9 +363,9 @@ void close_sensitivities(RunContext& c) {
     columns.push_back({{"name", c.result.sensitivity_columns[k]}, {"unit", c.result.sensitivity_units[k]}});
   json j;
   j["method"] = "IDAS forward sensitivities (staggered corrector on the run's Newton matrix; sensitivities in the "
-                "local error test, their tolerances at least 1e-9 of the state's size); F_y s, F_p, consistent initial "
-                "values and sensors by central differences over twin models at p +- d, F_y from the formulation's "
-                "Newton matrix where the differences fail (docs/sensitivities.md)";
+                "local error test, their tolerances at least 1e-9 of the state's size, out of it for windows after a "
+                "failure there); F_y from the formulation's Newton matrix at cj = 0; F_p, consistent initial values and "
+                "sensors by central differences over twin models at p +- d (docs/sensitivities.md)";
   j["parameters"] = params;
   j["columns"] = columns;
   j["rows"] = c.result.sensitivities.empty() ? 0 : c.result.sensitivities[0].size();
