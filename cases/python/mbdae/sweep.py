@@ -250,6 +250,8 @@ def sweep(scene, params, out, client=None, metrics=None, options=None, workers=N
     check_parameters(scene, runs)
     check_metrics(scene, metrics)
     check_sensitivities(scene, runs, options)
+    if not isinstance(out, (str, os.PathLike)) or not str(out):
+        raise TypeError(f"out expects the sweep's folder (a non-empty str or path), got {type(out).__name__} {out!r}")
     out = Path(out)
     try:
         (out / "runs").mkdir(parents=True, exist_ok=True)

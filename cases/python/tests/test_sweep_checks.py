@@ -320,3 +320,10 @@ def test_full_disk_is_a_clear_error_and_keeps_the_runs_done(tmp_path, monkeypatc
     finally:
         if disk:
             subprocess.run(["umount", str(disk)], check=False)
+
+
+def test_an_out_that_names_no_folder_is_a_type_error_naming_out(tmp_path):
+    for bad in (None, 3, ""):
+        with pytest.raises(TypeError) as e:
+            mbdae.sweep(short_scene(), GRID, out=bad, progress=False)
+        assert str(e.value).startswith("out expects the sweep's folder"), str(e.value)
