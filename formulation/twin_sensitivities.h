@@ -4,19 +4,19 @@
 // same coordinates and equations), whose modes and turns follow the run's. The sensitivity
 // equations' residual is
 //
-//   F_y s + F_y' s' + F_p  =  F_y' s'  +  [F+(y + d s, y') - F-(y - d s, y')] / (2 d),
+//   F_y s + F_y' s' + F_p  =  A0 s  +  F_y' s'  +  [F+(y, y') - F-(y, y')] / (2 d),
 //
-// F_y' s' exact, from the formulation (MultibodyDae::derivative_times: every formulation's F is
-// affine in y', F_y' holds the identity, the mass matrix and index1's Phi_q); F_y s + F_p one
+// A0 = F_y the formulation's own Newton matrix at cj = 0 (exact, one assembly per call for all
+// parameters, on a copy of the run's DAE); F_y' s' exact, from the formulation
+// (MultibodyDae::derivative_times: every formulation's F is affine in y', F_y' holds the
+// identity, the mass matrix and index1's Phi_q); F_p the twins' central difference at the same
+// (y, y'), where the terms that do not depend on p are evaluated bit for bit alike and cancel,
+// so that no parameter needs code of its own (force parameters, masses, hardpoints, gravity,
+// expression constants alike). With `difference_first` (measurement only) F_y s + F_p is one
 // central difference of the twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), two
-// residuals per parameter, and no parameter needs code of its own (force parameters, masses,
-// hardpoints, gravity, expression constants alike). Where IDA fails with it (its rounding,
-// eps |F| / d, is 1e5 times that of the state: Dynamics I with the wheel mass at the ground
-// step's restart), fall_back() turns to A0 s, A0 = F_y the formulation's own Newton matrix at
-// cj = 0 (exact, one assembly per call for all parameters, on a copy of the run's DAE), plus F_p
-// as the twins' difference at the same (y, y') (the terms that do not depend on p are evaluated
-// bit for bit alike in both twins and cancel), and the driver retries from the last step; from
-// then on A0 serves the first residuals after every start of IDA (fall_back, below).
+// residuals and no assembly, until it fails (then A0 in windows after every start of IDA,
+// fall_back below); its truncation, d^2 times the third derivative along (s, 1), put A05's
+// sensitivities 1.8e-1 off (docs/sensitivities.md, Method).
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 #pragma once
