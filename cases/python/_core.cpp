@@ -153,6 +153,7 @@ void bind_run(py::module_& m) {
       .def_readwrite("analysis", &mbdae::RunOptions::analysis)
       .def_readwrite("verbose", &mbdae::RunOptions::verbose)
       .def_readwrite("progress", &mbdae::RunOptions::progress)
+      .def_readwrite("report_failures", &mbdae::RunOptions::report_failures)
       .def_readwrite("out_dir", &PyRunOptions::out_dir)
       .def_readwrite("animation_dir", &PyRunOptions::animation_dir)
       .def_readwrite("animation_rate", &PyRunOptions::animation_rate)

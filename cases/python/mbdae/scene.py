@@ -123,7 +123,7 @@ class Scene:
 
     def run(self, rtol=None, atol=None, formulation=None, output_step=None, analysis=None, out=None,
             raise_on_failure=True, animation=None, animation_rate=None, error_estimate=None, error_target=None,
-            error_sensors=None, error_warnings=True, sensitivities=None):
+            error_sensors=None, error_warnings=True, sensitivities=None, report_failures=True):
         """Runs the analyses (the CLI's `mbdae run`): tolerances, output step and formulation
         override the scene's when given; `analysis` (an index or a step type such as "dynamics")
         stops after that step; `out` also writes results.csv and summary.json there. `animation`
@@ -138,7 +138,8 @@ class Scene:
         keeps the estimate's warnings (over 10 rtol) off stderr. `sensitivities` (a parameter path
         as a str, or a list or tuple of them, as `set` takes them; other types are a TypeError)
         also integrates d(sensor)/d(parameter) of every output sensor (Result.sensitivities,
-        docs/sensitivities.md). Returns a Result; a failed
+        docs/sensitivities.md). report_failures=False keeps a failure's one-line message (and a
+        stop of the sensitivities) off stderr: the Result holds it. Returns a Result; a failed
         solve raises SolveError carrying the partial Result (or returns it, with
         raise_on_failure=False). The GIL is released while solving."""
         opt = self.run_options(rtol, atol, formulation, output_step, analysis, sensitivities)
@@ -157,6 +158,9 @@ class Scene:
             if not isinstance(error_warnings, bool):
                 raise ValueError(f"error_warnings expects True or False, got {error_warnings!r}")
             opt.error_warnings = error_warnings
+            if not isinstance(report_failures, bool):
+                raise ValueError(f"report_failures expects True or False, got {report_failures!r}")
+            opt.report_failures = report_failures
             result = Result._from_core(_scene_errors(_core.run, self._core, opt))
         except BaseException:
             if temporary:

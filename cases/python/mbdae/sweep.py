@@ -70,7 +70,8 @@ def run_one(scene, run, options, metrics):
     opts = dict(options, **{k: plain(v) for k, v in run.items() if k in RUN_OPTIONS})
     result = None
     try:
-        result = scene.with_params(overrides).run(raise_on_failure=False, **opts)
+        # The row holds a failure's message: not on stderr, where threads' lines name no run.
+        result = scene.with_params(overrides).run(raise_on_failure=False, report_failures=False, **opts)
     except (SceneError, ValueError) as e:  # a bad override or run option
         row.update(status="invalid", message=str(e))
     except Exception as e:  # noqa: BLE001 -- recorded in the table, the sweep goes on

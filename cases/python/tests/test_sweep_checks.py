@@ -327,3 +327,13 @@ def test_an_out_that_names_no_folder_is_a_type_error_naming_out(tmp_path):
         with pytest.raises(TypeError) as e:
             mbdae.sweep(short_scene(), GRID, out=bad, progress=False)
         assert str(e.value).startswith("out expects the sweep's folder"), str(e.value)
+
+
+def test_failed_runs_in_a_sweep_print_no_bare_line(tmp_path, capfd):
+    """A failing run is a row with its message; nothing on stderr names no run."""
+    table = mbdae.sweep(short_scene(), {"forces.suspension.damping": [1400.0, 1e300]}, out=tmp_path / "s",
+                        client="threads", progress=False)
+    assert list(table["status"])[0] == "ok" and list(table["status"])[1] != "ok", list(table["status"])
+    assert table["message"].iloc[1], "the failed run's row keeps its message"
+    err = capfd.readouterr().err
+    assert "mbdae: " not in err, err
