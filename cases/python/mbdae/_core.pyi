@@ -29,6 +29,7 @@ class RunOptions(RunOptionsBase):
     analysis: int
     verbose: bool
     progress: bool
+    report_failures: bool
     out_dir: str
     animation_dir: str
     animation_rate: float
