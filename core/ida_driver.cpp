@@ -322,7 +322,6 @@ void reinit(IdaRun& r, double tt) {
   check(IDAReInit(r.mem, tt, r.y, r.yp), "IDAReInit");
   if (r.sens_on) {
     check(IDASensReInit(r.mem, IDA_STAGGERED, r.s, r.sp), "IDASensReInit");
-    r.o->sensitivities->reinitialized();
     sensitivity_test_window(r, true);
   }
 }

@@ -63,9 +63,8 @@ struct IdaStats {
   long sensitivity_residual_evals = 0, sensitivity_nonlinear_iterations = 0;
   long sensitivity_error_test_failures = 0, sensitivity_nonlinear_failures = 0;
   std::string sensitivity_failure;  // non-empty: IDA failed with them, and the run went on without
-  double sensitivity_fallback_time = -1;  // >= 0: where they first switched to their robust residual
   double sensitivity_test_off_time = -1;  // >= 0: where a failure first took them out of the error test
-  int sensitivity_fallbacks = 0;           // retries from the last step with the robust residual
+  int sensitivity_fallbacks = 0;           // retries from the last step (out of their error test)
   double cpu_seconds = 0;
   double last_step = 0;
   double t_reached = 0;

@@ -145,8 +145,8 @@ void open_sensitivities(IdaRun& r);
 bool interpolate_sensitivities(IdaRun& r, double tt, N_Vector* s, N_Vector* sp);
 // The sensitivities at the last accepted step into r.s, r.sp; false (the run not failed) if not.
 bool sensitivities_at_last_step(IdaRun& r);
-// IDA failed with the sensitivities on: their robust residual from the last accepted step, or
-// the run on without them. True: the run goes on.
+// IDA failed with the sensitivities on: them again from the last accepted step out of their
+// error test for a window (sensitivities_out_of_test), or the run on without them. True: the run goes on.
 bool drop_sensitivities(IdaRun& r, int flag);
 // The same for a reason of the driver's own (the steps held back by the sensitivities).
 bool drop_sensitivities(IdaRun& r, const std::string& why);

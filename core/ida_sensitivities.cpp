@@ -118,7 +118,7 @@ bool sensitivities_at_last_step(IdaRun& r) {
   return true;
 }
 
-// The sensitivities' robust residual from the last accepted step: their values there (IDAS's
+// The sensitivities again from the last accepted step: their values there (IDAS's
 // interpolant), made consistent by the problem, and IDA anew. False if that cannot be done.
 static bool retry_sensitivities(IdaRun& r) {
   if (!sensitivities_at_last_step(r)) return false;
@@ -145,8 +145,7 @@ bool drop_sensitivities(IdaRun& r, int flag) {
   return drop_sensitivities(r, os.str());
 }
 
-// After a failure with the sensitivities in the local error test (and with A0, where the
-// problem has it): their error test off for a window of steps after every start of IDA from
+// After a failure with the sensitivities in the local error test: their error test off for a window of steps after every start of IDA from
 // here on (the retry is one), twice as long after each further failure while it is on; after
 // kMaxTestFailures, off to the end. Measured: the first steps after an event, cut by the
 // sensitivities' test to where their Newton iteration no longer converges (Dynamics I with the
@@ -172,10 +171,6 @@ void sensitivity_test_window(IdaRun& r, bool start) {
 }
 
 bool drop_sensitivities(IdaRun& r, const std::string& why) {
-  if (r.o->sensitivities->fall_back()) {
-    if (r.stats.sensitivity_fallback_time < 0) r.stats.sensitivity_fallback_time = r.t_prev;
-    if (retry_sensitivities(r)) return true;
-  }
   if (sensitivities_out_of_test(r)) return true;
   std::ostringstream os;
   os << why << "; the run went on without them from t = " << r.t_prev;

@@ -29,12 +29,6 @@ class SensitivityProblem {
   virtual void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) = 0;
   // The segment the integrator works on (DaeProblem::set_segment), for the problem's own copies.
   virtual void set_segment(double /*t_start*/, double /*t_end*/) {}
-  // After IDA failed with the sensitivities: switch to a more robust (dearer) residual and return
-  // true, the driver then retries from the last accepted step; false if there is none.
-  virtual bool fall_back() { return false; }
-  // IDA starts anew (a restart at an event or a breakpoint, a retry): its first
-  // steps are tiny.
-  virtual void reinitialized() {}
   // Whether the sensitivities are in the local error test (else only in the Newton test).
   virtual bool in_error_test() const { return false; }
 };

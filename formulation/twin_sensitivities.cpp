@@ -8,12 +8,8 @@
 namespace mbdae {
 
 TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base,
-                                     std::vector<ParameterTwins> twins, bool in_error_test, bool difference_first)
+                                     std::vector<ParameterTwins> twins, bool in_error_test)
     : run_(run), base_(std::move(base)), twins_(std::move(twins)), in_error_test_(in_error_test) {
-  if (!difference_first) {  // A0 to the end, as after kMaxFailures failures of the difference
-    exact_ = true;
-    failures_ = kMaxFailures;
-  }
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
   a0_.resize(base_->jacobian_pattern().nnz());
@@ -44,37 +40,30 @@ void TwinSensitivities::set_segment(double t_start, double t_end) {
 int TwinSensitivities::residual(double t, const double* y, const double* yp, const double*, const double* const* s,
                                 const double* const* sp, double* const* r) {
   follow(*base_);
-  if (exact_ && after_start_ && ++exact_calls_ > window_) exact_ = false;
-  if (exact_) base_->jacobian(t, 0.0, y, yp, a0_.data());
+  base_->jacobian(t, 0.0, y, yp, a0_.data());  // one assembly for all parameters
   for (size_t i = 0; i < twins_.size(); ++i) {
     base_->derivative_times(y, sp[i], r[i]);
-    if (exact_) add_assembled_state_term(s[i], r[i]);
-    // F_p alone after fall_back() (A0 s holds F_y s), else F_y s + F_p together.
-    if (const int flag = add_twin_difference(t, y, yp, twins_[i], exact_ ? nullptr : s[i], r[i]); flag != 0)
-      return flag;
+    add_assembled_state_term(s[i], r[i]);
+    if (const int flag = add_parameter_difference(t, y, yp, twins_[i], r[i]); flag != 0) return flag;
   }
   return 0;
 }
 
-// r += [F+(y + d s, y') - F-(y - d s, y')] / (2 d): the twins' central difference along the
-// state's direction s and the parameter together, F_y s + F_p, two residuals; without s (null),
-// at the same (y, y'): F_p alone.
-int TwinSensitivities::add_twin_difference(double t, const double* y, const double* yp, ParameterTwins& p,
-                                           const double* s, double* r) {
+// r += [F+(y, y') - F-(y, y')] / (2 d) = F_p: the twins' central difference at the run's state,
+// two residuals (every term that does not depend on p is alike in both and cancels).
+int TwinSensitivities::add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p,
+                                                double* r) {
   const int n = run_.size();
   for (int sign = 1; sign >= -1; sign -= 2) {
     MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
     follow(twin);
-    if (s)
-      for (int k = 0; k < n; ++k) yt_[k] = y[k] + sign * p.delta * s[k];
-    if (const int flag = twin.residual(t, s ? yt_.data() : y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0)
-      return flag;
+    if (const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
   }
   for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
   return 0;
 }
 
-// r += A0 s (after fall_back()).
+// r += A0 s.
 void TwinSensitivities::add_assembled_state_term(const double* s, double* r) const {
   const CscPattern& pat = base_->jacobian_pattern();
   for (int c = 0; c < run_.size(); ++c)

@@ -12,11 +12,10 @@
 // identity, the mass matrix and index1's Phi_q); F_p the twins' central difference at the same
 // (y, y'), where the terms that do not depend on p are evaluated bit for bit alike and cancel,
 // so that no parameter needs code of its own (force parameters, masses, hardpoints, gravity,
-// expression constants alike). With `difference_first` (measurement only) F_y s + F_p is one
-// central difference of the twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), two
-// residuals and no assembly, until it fails (then A0 in windows after every start of IDA,
-// fall_back below); its truncation, d^2 times the third derivative along (s, 1), put A05's
-// sensitivities 1.8e-1 off (docs/sensitivities.md, Method).
+// expression constants alike). Until 2026-11-27 F_y s + F_p was one central difference of the
+// twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), with A0 only after its failures:
+// its truncation, d^2 times the third derivative along (s, 1), put A05's sensitivities 1.8e-1
+// off (docs/sensitivities.md, Method).
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 #pragma once
@@ -41,10 +40,8 @@ class TwinSensitivities : public SensitivityProblem {
  public:
   // `run` is the formulation being integrated; the twins must have its size.
   // `base` is another copy of the run's formulation on the run's own model (its Newton matrix).
-  // `difference_first`: F_y s + F_p by the one difference of the twins until it fails (then A0
-  // after every start, below); else (the run's choice) A0 s + F_p from the start.
   TwinSensitivities(MultibodyDae& run, std::unique_ptr<MultibodyDae> base, std::vector<ParameterTwins> twins,
-                    bool in_error_test, bool difference_first = false);
+                    bool in_error_test);
 
   int count() const override { return static_cast<int>(twins_.size()); }
   double scale(int i) const override { return twins_[i].scale; }
@@ -55,26 +52,6 @@ class TwinSensitivities : public SensitivityProblem {
   void set_segment(double t_start, double t_end) override;
   bool in_error_test() const override { return in_error_test_; }
   bool reads_state_residual() const override { return false; }
-  // From the twins' central differences to the Newton matrix's A0 (exact, dearer). The
-  // differences can fail where the steps are tiny, as after IDA starts anew (their rounding,
-  // amplified by 1 / h, above the sensitivities' Newton tolerance): from the first failure on,
-  // A0 serves a window of residuals after every start of IDA (a failure's retry is one), the
-  // window twice as long after each further failure, and the differences the rest; after
-  // kMaxFailures, A0 to the end. False if A0 failed.
-  bool fall_back() override {
-    if (exact_) return false;
-    if (failures_ > 0) window_ *= 2;
-    after_start_ = ++failures_ < kMaxFailures;
-    exact_ = true;
-    exact_calls_ = 0;
-    return true;
-  }
-  void reinitialized() override {
-    if (!after_start_) return;
-    exact_ = true;
-    exact_calls_ = 0;
-  }
-
   // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' consistent
   // output (projected when `project`) and sensors at y +- d s_i. False, with `failure` set,
   // when a twin's output state cannot be formed.
@@ -85,8 +62,7 @@ class TwinSensitivities : public SensitivityProblem {
 
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
-  int add_twin_difference(double t, const double* y, const double* yp, ParameterTwins& p, const double* s,
-                          double* r);
+  int add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
   void add_assembled_state_term(const double* s, double* r) const;
 
   MultibodyDae& run_;
@@ -94,12 +70,6 @@ class TwinSensitivities : public SensitivityProblem {
   std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
-  bool exact_ = false;  // A0 = F_y assembled (after fall_back), else F_y s + F_p by one difference
-  bool after_start_ = false;  // exact_ only for window_ residuals after a start or a failure
-  int exact_calls_ = 0;  // residuals since then
-  int window_ = 50;
-  int failures_ = 0;
-  static constexpr int kMaxFailures = 10;
   std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
   std::string failure_;

@@ -302,14 +302,12 @@ void sensitivity_statistics(RunContext& c, const IdaStats& st, json& stats) {
   stats["sensitivity_residual_evaluations"] = st.sensitivity_residual_evals;
   stats["sensitivity_nonlinear_iterations"] = st.sensitivity_nonlinear_iterations;
   stats["sensitivity_nonlinear_failures"] = st.sensitivity_nonlinear_failures;
-  // Where the differences first failed and the assembled Newton matrix took over, and how many
-  // retries that took (formulation/twin_sensitivities.h).
-  if (st.sensitivity_fallback_time >= 0) {
-    stats["sensitivity_assembled_from"] = st.sensitivity_fallback_time;
+  // Where a failure first took them out of the local error test for a window after each start,
+  // and the retries from the last accepted step that took.
+  if (st.sensitivity_test_off_time >= 0) {
+    stats["sensitivity_error_test_windows_from"] = st.sensitivity_test_off_time;
     stats["sensitivity_fallbacks"] = st.sensitivity_fallbacks;
   }
-  // Where a failure first took them out of the local error test for a window after each start.
-  if (st.sensitivity_test_off_time >= 0) stats["sensitivity_error_test_windows_from"] = st.sensitivity_test_off_time;
   RunSensitivities& rs = *c.sensitivities;
   rs.event_times.insert(rs.event_times.end(), st.event_times.begin(), st.event_times.end());
 }
