@@ -33,12 +33,15 @@ void write_columns(const std::string& path, const std::vector<std::string>& name
 
 }  // namespace
 
+void SensitivityCsvSink::open(const std::vector<std::string>& columns) {
+  csv_.open(path_, columns);
+  row_.resize(columns.size());
+  open_ = true;
+}
+
 void SensitivityCsvSink::begin(const RunInfo& info) {
   result_ = info.result;
-  if (open_ || !result_ || result_->sensitivity_columns.empty()) return;
-  csv_.open(path_, result_->sensitivity_columns);
-  row_.resize(result_->sensitivity_columns.size());
-  open_ = true;
+  if (!open_ && result_ && !result_->sensitivity_columns.empty()) open(result_->sensitivity_columns);
 }
 
 void SensitivityCsvSink::sample(const Sample&) {
@@ -56,11 +59,7 @@ void SensitivityCsvSink::write_rows(const Result& r) {
 
 void SensitivityCsvSink::end(const Result& r) {
   if (r.sensitivity_columns.empty()) return;
-  if (!open_) {  // no integration step (static steps only): the header
-    csv_.open(path_, r.sensitivity_columns);
-    row_.resize(r.sensitivity_columns.size());
-    open_ = true;
-  }
+  if (!open_) open(r.sensitivity_columns);  // no integration step (static steps only): the header
   write_rows(r);
   csv_.close();
   if (normalized_path_.empty()) return;

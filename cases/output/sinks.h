@@ -41,6 +41,7 @@ class SensitivityCsvSink : public Sink {
   void end(const Result& result) override;
 
  private:
+  void open(const std::vector<std::string>& columns);
   void write_rows(const Result& r);  // the rows computed since the last call
   std::string path_, normalized_path_;
   const Result* result_ = nullptr;

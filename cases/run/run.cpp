@@ -149,10 +149,10 @@ void close_summary(RunContext& c) {
   c.result.summary["steps"] = c.steps;
 }
 
-void fail(RunContext& c, const std::string& status, const std::string& message, json step) {
-  step["status"] = status;
-  step["message"] = message;
-  c.steps.push_back(step);
+namespace {
+
+// The run's status and message in the summary and the result, exit code 3.
+void end_failed(RunContext& c, const std::string& status, const std::string& message) {
   c.result.summary["status"] = status;
   c.result.summary["message"] = message;
   close_summary(c);
@@ -161,6 +161,15 @@ void fail(RunContext& c, const std::string& status, const std::string& message, 
   c.result.exit_code = 3;
   c.result.q = c.q;
   c.result.system = c.system;
+}
+
+}  // namespace
+
+void fail(RunContext& c, const std::string& status, const std::string& message, json step) {
+  step["status"] = status;
+  step["message"] = message;
+  c.steps.push_back(step);
+  end_failed(c, status, message);
   if (c.options.report_failures)  // also under --quiet: a failure is always said
     std::fprintf(stderr, "mbdae: %s\n", message.c_str());
 }
@@ -247,14 +256,10 @@ Result run(const Scene& scene, const RunOptions& options, const std::vector<Sink
   // Sensitivities that stopped while the run went on leave sensitivities.csv short of
   // results.csv: not a whole run (status sensitivities_failed, exit code 3).
   // (Their failure was said on stderr when it happened: sensitivities_failed.)
-  if (result.exit_code == 0 && c.sensitivities && c.sensitivities->status != "ok") {
-    summary["status"] = result.status = "sensitivities_failed";
-    summary["message"] = result.message = "the sensitivities stopped (" + c.sensitivities->status + "): " +
-                                          c.sensitivities->message + "; results.csv is whole, sensitivities.csv ends there";
-    close_summary(c);
-    result.exit_code = 3;
-    result.q = c.q;
-  }
+  if (result.exit_code == 0 && c.sensitivities && c.sensitivities->status != "ok")
+    end_failed(c, "sensitivities_failed",
+               "the sensitivities stopped (" + c.sensitivities->status + "): " + c.sensitivities->message +
+                   "; results.csv is whole, sensitivities.csv ends there");
   if (result.exit_code == 0) {
     summary["status"] = "ok";
     close_summary(c);
