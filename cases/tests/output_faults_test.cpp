@@ -134,6 +134,18 @@ class OutputFaults : public mbdae::test_support::RunFolderTest {
     waitpid(pid, nullptr, 0);
     return false;
   }
+  // SIGKILLs run `pid` and waits until the repair of `partial` (cut back to whole rows) is done:
+  // a reader's flock waits for it (core/output_guard.h).
+  void kill_and_wait_for_repair(pid_t pid, const fs::path& partial) {
+    kill(pid, SIGKILL);
+    int sig = 0;
+    wait_exit(pid, &sig);
+    EXPECT_EQ(sig, SIGKILL);
+    const int reader = ::open(partial.c_str(), O_RDONLY | O_CLOEXEC);
+    ASSERT_GE(reader, 0);
+    EXPECT_EQ(::flock(reader, LOCK_SH), 0);
+    ::close(reader);
+  }
   static int wait_exit(pid_t pid, int* signal = nullptr) {
     int status = 0;
     waitpid(pid, &status, 0);
@@ -249,14 +261,7 @@ TEST_F(OutputFaults, SigkillLeavesWholeRows) {
     fs::remove_all(out);
     const pid_t pid = start(scene("10000"), "run.log");
     ASSERT_TRUE(wait_for_rows(pid, 20000 + 37000 * k));
-    kill(pid, SIGKILL);
-    int sig = 0;
-    wait_exit(pid, &sig);
-    EXPECT_EQ(sig, SIGKILL);
-    const int reader = ::open((out / "results.csv.partial").c_str(), O_RDONLY | O_CLOEXEC);
-    ASSERT_GE(reader, 0);
-    EXPECT_EQ(::flock(reader, LOCK_SH), 0);
-    ::close(reader);
+    ASSERT_NO_FATAL_FAILURE(kill_and_wait_for_repair(pid, out / "results.csv.partial"));
     EXPECT_GT(check_whole_rows(out / "results.csv.partial"), 100);
     EXPECT_FALSE(fs::exists(out / "results.csv"));
     EXPECT_FALSE(fs::exists(out / "summary.json"));
@@ -268,14 +273,7 @@ TEST_F(OutputFaults, SigkillLeavesWholeRows) {
 TEST_F(OutputFaults, SigkillLeavesWholeSensitivityRows) {
   const pid_t pid = start(scene("10000"), "run.log", "bodies.arm.mass");
   ASSERT_TRUE(wait_for_rows(pid, 60000));
-  kill(pid, SIGKILL);
-  int sig = 0;
-  wait_exit(pid, &sig);
-  EXPECT_EQ(sig, SIGKILL);
-  const int reader = ::open((out / "sensitivities.csv.partial").c_str(), O_RDONLY | O_CLOEXEC);
-  ASSERT_GE(reader, 0);
-  EXPECT_EQ(::flock(reader, LOCK_SH), 0);
-  ::close(reader);
+  ASSERT_NO_FATAL_FAILURE(kill_and_wait_for_repair(pid, out / "sensitivities.csv.partial"));
   const long results = check_whole_rows(out / "results.csv.partial");
   const std::string text = read_file(out / "sensitivities.csv.partial");
   ASSERT_FALSE(text.empty());
