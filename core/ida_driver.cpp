@@ -374,6 +374,8 @@ bool restart(IdaRun& r, const int* roots) {
     if (r.sens_on) {  // the sensitivities at t (IDAS's), made consistent with the restarted state
       r.o->sensitivities->set_segment(r.t, segment_end(r));
       if (!interpolate_sensitivities(r, r.t, r.s, r.sp)) return false;
+      // keep_step() stored the derivative IDA reached the breakpoint with.
+      if (!roots) r.o->sensitivities->jump_at_breakpoint(r.t, r.yp_prev.data(), data(r.yp), r.s_data.data());
       r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
     }
   } catch (const SolveError& e) {

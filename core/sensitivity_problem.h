@@ -27,6 +27,12 @@ class SensitivityProblem {
   // After the problem's restart at t made (y, y') consistent: consistent (s[i], sp[i]) from
   // the s[i] before it. Throws SolveError on failure.
   virtual void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) = 0;
+  // At a breakpoint t_b (an input's jump at a fixed time, DaeProblem::breakpoints), before
+  // restart(): s[i] += (y'- - y'+) dt_b/dp_i on the differential unknowns, the jump that the
+  // breakpoint's own dependence on p_i gives (y'- the derivative IDA reached t_b with, y'+ the
+  // restarted one). Nothing for parameters that do not move it.
+  virtual void jump_at_breakpoint(double /*t*/, const double* /*yp_before*/, const double* /*yp_after*/,
+                                  double* const* /*s*/) {}
   // The segment the integrator works on (DaeProblem::set_segment), for the problem's own copies.
   virtual void set_segment(double /*t_start*/, double /*t_end*/) {}
   // Whether the sensitivities are in the local error test (else only in the Newton test).

@@ -65,8 +65,13 @@ class MultibodyDae : public DaeProblem {
   // there, an error of rate x width (1e-13 s made rtol 1e-13 fail at a drive's kink).
   double input_time(double t) const {
     const double cap = segment_end_ - 16 * 2.220446049250313e-16 * (1.0 + std::fabs(segment_end_));
+    if (t < inputs_from_) return inputs_from_;
     return t < cap ? t : cap;
   }
+  // Inputs before t_start are held at their value at t_start (the right limit of a jump there):
+  // a sensitivity twin whose breakpoint lies after the run's sees its own jump already where the
+  // run's segment starts (formulation/twin_sensitivities.h). -inf (the default): no hold.
+  void hold_inputs_from(double t_start) { inputs_from_ = t_start; }
 
   // Consistent initial values from the q and v in y: q and v projected onto the constraints,
   // y' = [v, a, 0...], lambda after v, the unknowns beyond 2 nq + nc (GGL's mu) zero.
@@ -207,6 +212,7 @@ class MultibodyDae : public DaeProblem {
   ConstraintRowsPattern rows_pattern_;  // Phi_q's structural entries (the residuals' Phi_q^T lambda)
   double mass_scale_ = 1e-3;  // largest body mass (multipliers are forces: mass-scaled weights)
   double segment_end_ = 1e300;
+  double inputs_from_ = -1e300;
   std::vector<int> switch_forces_;
   // Per switching function, its value at the last restart where that value disagreed with the
   // mode (else 0): the root function is g - offset, so that the next crossing is seen (restart).

@@ -1,5 +1,7 @@
 #include "formulation/twin_sensitivities.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -13,9 +15,15 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
   a0_.resize(base_->jacobian_pattern().nnz());
-  for (const ParameterTwins& p : twins_)
+  breakpoints_ = run_.breakpoints();
+  for (ParameterTwins& p : twins_) {
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
       throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
+    p.breakpoints_plus = p.plus->breakpoints();
+    p.breakpoints_minus = p.minus->breakpoints();
+    if (p.breakpoints_plus.size() != breakpoints_.size() || p.breakpoints_minus.size() != breakpoints_.size())
+      throw std::invalid_argument("TwinSensitivities: twins with other breakpoints than the run's");
+  }
   yt_.resize(n);
   ypt_.resize(n);
   rp_.resize(n);
@@ -29,11 +37,37 @@ void TwinSensitivities::follow(MultibodyDae& twin) {
   twin.state().turns = run_.state().turns;
 }
 
+int TwinSensitivities::run_breakpoint(double t) const {
+  for (size_t k = 0; k < breakpoints_.size(); ++k)
+    if (std::fabs(t - breakpoints_[k]) <= 1e-12 * std::max(1.0, std::fabs(t))) return static_cast<int>(k);
+  return -1;
+}
+
+// A segment's ends that are the run's breakpoints become the twin's own; its inputs are held
+// from its own start where that lies after the run's.
 void TwinSensitivities::set_segment(double t_start, double t_end) {
   base_->set_segment(t_start, t_end);
-  for (ParameterTwins& p : twins_) {
-    p.plus->set_segment(t_start, t_end);
-    p.minus->set_segment(t_start, t_end);
+  const int ks = run_breakpoint(t_start), ke = run_breakpoint(t_end);
+  for (ParameterTwins& p : twins_)
+    for (int side = 0; side < 2; ++side) {
+      MultibodyDae& twin = side == 0 ? *p.plus : *p.minus;
+      const std::vector<double>& b = side == 0 ? p.breakpoints_plus : p.breakpoints_minus;
+      const double start = ks >= 0 ? b[ks] : t_start;
+      twin.set_segment(start, ke >= 0 ? b[ke] : t_end);
+      twin.hold_inputs_from(start > t_start ? start : -1e300);
+    }
+}
+
+void TwinSensitivities::jump_at_breakpoint(double t, const double* yp_before, const double* yp_after,
+                                           double* const* s) {
+  const int k = run_breakpoint(t);
+  if (k < 0) return;
+  const int nd = 2 * run_.nq();  // q and v: every formulation's differential unknowns
+  for (size_t i = 0; i < twins_.size(); ++i) {
+    const ParameterTwins& p = twins_[i];
+    const double dtdp = (p.breakpoints_plus[k] - p.breakpoints_minus[k]) / (2 * p.delta);
+    if (dtdp == 0) continue;
+    for (int j = 0; j < nd; ++j) s[i][j] += (yp_before[j] - yp_after[j]) * dtdp;
   }
 }
 

@@ -18,6 +18,12 @@
 // off (docs/sensitivities.md, Method).
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
+// A parameter that moves a breakpoint t_b (the time of an input's jump: a ground step, a point
+// force's step): each twin keeps its own breakpoint, the run's segment mapped onto the twin's
+// (its inputs held at their left limit before its t_b and at their right limit after it, so
+// that F_p is not the jump over 2 d where the twins' t_b straddle the run's time), and at the
+// run's t_b the sensitivities jump by (y'- - y'+) dt_b/dp on q and v (an ODE's classic jump
+// condition: q and v are continuous there, v' jumps), dt_b/dp the twins' difference of t_b.
 #pragma once
 
 #include <memory>
@@ -34,6 +40,7 @@ struct ParameterTwins {
   double scale = 1;  // a typical magnitude of the parameter (IDAS's pbar)
   // Each twin's consistent initial (y, y') from its own chain of analyses.
   std::vector<double> y_plus, yp_plus, y_minus, yp_minus;
+  std::vector<double> breakpoints_plus, breakpoints_minus;  // each twin's (set by TwinSensitivities)
 };
 
 class TwinSensitivities : public SensitivityProblem {
@@ -50,6 +57,7 @@ class TwinSensitivities : public SensitivityProblem {
   void initial(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
   void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) override;
   void set_segment(double t_start, double t_end) override;
+  void jump_at_breakpoint(double t, const double* yp_before, const double* yp_after, double* const* s) override;
   bool in_error_test() const override { return in_error_test_; }
   bool reads_state_residual() const override { return false; }
   // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' consistent
@@ -65,7 +73,10 @@ class TwinSensitivities : public SensitivityProblem {
   int add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
   void add_assembled_state_term(const double* s, double* r) const;
 
+  int run_breakpoint(double t) const;  // the index of t among the run's breakpoints, or -1
+
   MultibodyDae& run_;
+  std::vector<double> breakpoints_;  // the run's
   std::unique_ptr<MultibodyDae> base_;
   std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y
   std::vector<ParameterTwins> twins_;

@@ -73,26 +73,62 @@ std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParamet
   return tw;
 }
 
-// A parameter that moves the time of a breakpoint (the ground step's time, a drive's switch)
-// inside an integrated step: the sensitivities jump there by (y'- - y'+) dt_b/dp, which the
-// twins' restart at the run's breakpoint does not give (the rows after it were measured 2.3
-// times off). Refused, naming the breakpoint.
-void check_breakpoints(const RunContext& c, const SensitivityParameter& p) {
+// A parameter that moves the time of a breakpoint inside an integrated step: the twins keep
+// their own breakpoints and the sensitivities jump at the run's (formulation/twin_sensitivities.h).
+// That holds for a force's step (a ground profile's, a point force's): q and v continuous, v'
+// jumping. Refused, naming the breakpoint: a drive's breakpoint (a kink or jump of a
+// constraint's target moves q or v themselves), breakpoints that appear, vanish or merge, and
+// any other input that varies with time (each twin holds its inputs over the d between its
+// breakpoint and the run's, which is exact for steps only).
+bool moves_inside_integrated_step(const RunContext& c, double b) {
+  for (const AnalysisStep& step : c.scene.steps) {
+    const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
+    if (integrated && b > step.t0 && b < step.t_end) return true;
+  }
+  return false;
+}
+
+std::string breakpoint_refusal(const System& sys, const System& twin) {
+  std::vector<double> drives, twin_drives;
+  for (const Constraint& k : sys.constraints)
+    if (k.type == Constraint::Type::kCoordinate)
+      for (double b : k.target.breakpoints()) drives.push_back(b);
+  for (const Constraint& k : twin.constraints)
+    if (k.type == Constraint::Type::kCoordinate)
+      for (double b : k.target.breakpoints()) twin_drives.push_back(b);
+  if (drives != twin_drives) return "a driven coordinate's breakpoint";
+  for (const Force& f : sys.forces)
+    for (const TimeFunction* g : {&f.fx, &f.fy, &f.fz, &f.ground})
+      if (g->kind != TimeFunction::Kind::kConstant && g->kind != TimeFunction::Kind::kStep)
+        return "a model whose force '" + f.name + "' has an input that varies with time (" + g->describe() +
+               "), which the twins cannot hold over their step (only a step can be)";
+  if (sys.breakpoints().size() != twin.breakpoints().size()) return "breakpoints that appear, vanish or merge";
+  return "";
+}
+
+void check_breakpoints(const RunContext& c, SensitivityParameter& p) {
   const std::vector<double> own = c.system->breakpoints();
   for (int side = 0; side < 2; ++side) {
-    const std::vector<double> twin = p.twin[side]->context->system->breakpoints();
+    const System& twin_sys = *p.twin[side]->context->system;
+    const std::vector<double> twin = twin_sys.breakpoints();
     for (size_t k = 0; k < std::max(own.size(), twin.size()); ++k) {
       const double b = k < own.size() ? own[k] : twin[k], bt = k < twin.size() ? twin[k] : NAN;
       if (k < own.size() && k < twin.size() && std::fabs(bt - b) <= 1e-14 * std::max(1.0, std::fabs(b))) continue;
-      for (const AnalysisStep& step : c.scene.steps) {
-        const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
-        if (!integrated || !(b > step.t0 && b < step.t_end)) continue;
-        throw ModelError(c.scene.file, 0, "sensitivities",
-                         "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) +
-                             " with " + p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
-                             "), inside an integrated step: the sensitivities would jump there by (y'- - y'+) dt/dp, "
-                             "which is not computed; it cannot be differentiated");
+      if (!moves_inside_integrated_step(c, b)) continue;
+      const std::string why = breakpoint_refusal(*c.system, twin_sys);
+      if (why.empty()) {
+        if (side == 0)
+          p.moved_breakpoints.push_back(
+              {{"t", b},
+               {"dt_dp", (bt - p.twin[1]->context->system->breakpoints()[k]) / (2 * p.delta)},
+               {"note", "the sensitivities jump there by (y'- - y'+) dt/dp on q and v (docs/sensitivities.md)"}});
+        continue;
       }
+      throw ModelError(c.scene.file, 0, "sensitivities",
+                       "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) + " with " +
+                           p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
+                           ") inside an integrated step, and the sensitivities' jump there is computed only for a "
+                           "force's step: this is " + why + "; it cannot be differentiated");
     }
   }
 }
@@ -354,8 +390,10 @@ void close_sensitivities(RunContext& c) {
   if (!c.sensitivities) return;
   const RunSensitivities& rs = *c.sensitivities;
   json params = json::array();
-  for (const SensitivityParameter& p : rs.parameters)
+  for (const SensitivityParameter& p : rs.parameters) {
     params.push_back({{"path", p.path}, {"value", p.value}, {"unit", p.unit}, {"difference_step", p.delta}});
+    if (!p.moved_breakpoints.empty()) params.back()["moves_breakpoints"] = p.moved_breakpoints;
+  }
   json columns = json::array();
   for (size_t k = 0; k < c.result.sensitivity_columns.size(); ++k)
     columns.push_back({{"name", c.result.sensitivity_columns[k]}, {"unit", c.result.sensitivity_units[k]}});

@@ -39,6 +39,7 @@ struct SensitivityParameter {
   double scale = 1;  // |value|, not below the model's own size in its unit (parameter_scale)
   double delta = 0;  // the twins' step, kRelativeStep * scale
   std::unique_ptr<TwinRun> twin[2];  // p + d, p - d
+  nlohmann::json moved_breakpoints;  // the breakpoints it moves inside an integrated step: t, dt/dp
 };
 
 struct RunSensitivities {

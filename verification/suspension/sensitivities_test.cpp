@@ -140,22 +140,39 @@ TEST(SuspensionSensitivities, DynamicsIWheelAgainstTyreDampingAndMass) {
   }
 }
 
-// The ground step's time is a breakpoint: a parameter that moves it would need the jump
-// (y'- - y'+) dt/dp at the restart, which is not computed, so it is refused before any stage
-// runs (the rows after the step were 2.3 times off before, alongside gravity.0).
-TEST(SuspensionSensitivities, AParameterThatMovesTheGroundStepIsRefused) {
+// The ground step's time moves a breakpoint: the sensitivities jump there by (v'- - v'+) dt/dp
+// (formulation/twin_sensitivities.h), checked against central differences of rtol 1e-10 runs
+// (step 1e-5 s) before the step (zero), through it to the first lift-off and after. A drive's
+// knot time moves a breakpoint whose jump is not computed: refused, naming it.
+TEST(SuspensionSensitivities, DynamicsIWheelAgainstTheGroundStepsTime) {
+  const Scene s = scene("dynamics_step.yaml");
   RunOptions opt;
-  opt.sensitivities = {"gravity.0", "forces.tyre.ground.time"};
+  opt.sensitivities = {"forces.tyre.ground.time"};
+  const Result r = run(s, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  RunOptions tight;
+  tight.rtol = 1e-10;
+  const auto& t = r.column("t");
+  for (const char* sensor : {"wheel_z", "wheel_vz"}) {
+    const auto fd = central_difference(s, "forces.tyre.ground.time", 0.2, 1e-5, sensor, tight);
+    const auto& sens = sensitivity(r, sensor, "forces.tyre.ground.time");
+    const double before = relative_error(t, sens, fd, 0, 0.2), through = relative_error(t, sens, fd, 0.2001, 0.235),
+                 after = relative_error(t, sens, fd, 0.235, 2);
+    std::printf("measured: Dynamics I d(%s)/d(ground step time): %.2e before the step, %.2e to the first lift-off, "
+                "%.2e after\n", sensor, before, through, after);
+    EXPECT_LT(before, 1e-12) << sensor;
+    EXPECT_LT(through, 1e-4) << sensor;
+    EXPECT_LT(after, 1e-4) << sensor;
+  }
+  opt.sensitivities = {"coordinates.q4.drive.points.1.0"};
   try {
-    run(scene("dynamics_step.yaml"), opt);
+    run(scene("kinematics.yaml"), opt);
     ADD_FAILURE() << "no error";
   } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find("'forces.tyre.ground.time' moves the breakpoint at t = 0.2"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("'coordinates.q4.drive.points.1.0' moves the breakpoint at t = 1"),
+              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a driven coordinate's breakpoint"), std::string::npos) << e.what();
   }
-  opt.sensitivities = {"gravity.0"};  // gravity moves no breakpoint
-  opt.analysis = 1;                   // through the equilibrium only: quick
-  EXPECT_TRUE(run(scene("dynamics_step.yaml"), opt).ok());
 }
 
 // Geometric parameters through the contact events: the tyre radius and a chassis hardpoint
