@@ -7,7 +7,7 @@
 namespace mbdae {
 
 void SparseAssembler::begin_pattern(int rows, int cols) {
-  recording_ = true;
+  recording_ = other_mode_ = true;
   trows_.clear();
   tcols_.clear();
   pattern_ = CscPattern{};
@@ -41,7 +41,29 @@ void SparseAssembler::finalize() {
   tcols_.clear();
   trows_.shrink_to_fit();
   tcols_.shrink_to_fit();
-  recording_ = false;
+  recording_ = other_mode_ = false;
+}
+
+void SparseAssembler::begin_product(int count, const double* const* x, double* const* out) {
+  if (recording_) throw std::logic_error("SparseAssembler: a product pass while recording a pattern");
+  other_mode_ = true;
+  product_count_ = count;
+  product_x_ = x;
+  product_out_ = out;
+}
+
+void SparseAssembler::end_product() {
+  other_mode_ = false;
+  product_count_ = 0;
+}
+
+void SparseAssembler::other_add(int row, int col, double v) {
+  if (recording_) {
+    trows_.push_back(row);
+    tcols_.push_back(col);
+    return;
+  }
+  for (int i = 0; i < product_count_; ++i) product_out_[i][row] += v * product_x_[i][col];
 }
 
 void SparseAssembler::begin_values(double* values) {

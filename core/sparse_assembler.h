@@ -31,10 +31,15 @@ class SparseAssembler {
   void begin_values(double* values);
   bool recording() const { return recording_; }
 
+  // Starts a product pass: the assembling code's add(row, col, v) calls do out[i][row] += v
+  // x[i][col] for i < count, a matrix-free product with the matrix that code assembles (no
+  // pattern, no values); end_product() ends it.
+  void begin_product(int count, const double* const* x, double* const* out);
+  void end_product();
+
   void add(int row, int col, double v) {
-    if (recording_) {
-      trows_.push_back(row);
-      tcols_.push_back(col);
+    if (other_mode_) {  // recording a pattern or multiplying
+      other_add(row, col, v);
       return;
     }
     if (cursor_ < calls_.size() && calls_[cursor_].row == row && calls_[cursor_].col == col) {
@@ -55,7 +60,12 @@ class SparseAssembler {
     int row, col, slot;  // the recorded add() and its position in the value array
   };
   void mismatch(int row, int col);
+  void other_add(int row, int col, double v);
   bool recording_ = false;
+  bool other_mode_ = false;  // recording_ or a product pass
+  int product_count_ = 0;
+  const double* const* product_x_ = nullptr;
+  double* const* product_out_ = nullptr;
   std::vector<int> trows_, tcols_;
   std::vector<Call> calls_;
   std::size_t cursor_ = 0;

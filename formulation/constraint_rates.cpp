@@ -6,16 +6,7 @@
 #include "formulation/constraints.h"
 
 namespace mbdae {
-namespace {
 
-// Whether local column l of a constraint's Hessian-vector rows is in the pattern: for the
-// constraints whose Hessian has no position (r) entries, the rows of H_i w, and of
-// d(v^T H_i v)/dq, vanish in the r columns.
-inline bool in_pattern(const Constraint& c, int l) {
-  return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || constraint_hessian_touches_r(c));
-}
-
-// Hessians of a constraint's rows, one per row.
 void row_hessians(const Constraint& c, const LocalState& s, Mat14* h) {
   for (int r = 0; r < c.rows(); ++r) {
     double w[3] = {0, 0, 0};
@@ -23,6 +14,15 @@ void row_hessians(const Constraint& c, const LocalState& s, Mat14* h) {
     h[r].setZero();
     constraint_hessian(c, s, w, h[r]);
   }
+}
+
+namespace {
+
+// Whether local column l of a constraint's Hessian-vector rows is in the pattern: for the
+// constraints whose Hessian has no position (r) entries, the rows of H_i w, and of
+// d(v^T H_i v)/dq, vanish in the r columns.
+inline bool in_pattern(const Constraint& c, int l) {
+  return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || constraint_hessian_touches_r(c));
 }
 
 // Phi_q v + Phi_t of one constraint, its Jacobian rows given.

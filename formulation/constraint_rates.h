@@ -20,6 +20,9 @@
 
 namespace mbdae {
 
+// H_r = d2(Phi_r)/dq2 (local 14 x 14) of each of constraint c's rows r at s.
+void row_hessians(const Constraint& c, const LocalState& s, Mat14* h);
+
 // Phi_q v + Phi_t (the velocity-level constraints).
 void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,
                                 const double* q, const double* v, double t, double* out);

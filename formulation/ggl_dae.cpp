@@ -47,6 +47,52 @@ void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
   assemble_hessian_vector_rows(sys_, offsets_, q, v, scale_, nullptr, 0.0, rw, cq, asm_);
 }
 
+void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int count, const double* const* x,
+                            double* const* out) {
+  const double t = input_time(t_in);
+  const double* q = y;
+  const double* v = y + nq_;
+  const double* lambda = y + 2 * nq_;
+  const double* mu = lambda + nc_;
+  for (int i = 0; i < count; ++i)
+    for (int j = 0; j < nq_; ++j) out[i][j] -= x[i][nq_ + j];  // F1: -I (v columns)
+  // F2: d(M v')/dq, the gyroscopic and the applied forces' derivatives, as assemble() adds them.
+  asm_.begin_product(count, x, out);
+  assemble_inertia_derivatives(sys_, q, v, yp + nq_, nq_, 0, nq_, asm_);
+  assemble_force_derivatives(sys_, state_.modes, q, v, t, nq_, 0, nq_, asm_, &state_.turns);
+  asm_.end_product();
+  Row14 rows[3];
+  Mat14 h[3];
+  for (size_t k = 0; k < sys_.constraints.size(); ++k) {
+    const Constraint& c = sys_.constraints[k];
+    const LocalState s = gather(q, c.bi, c.bj);
+    constraint_jacobian(c, s, rows);
+    row_hessians(c, s, h);
+    const Vec14 vl = gather_local(v, c.bi, c.bj);
+    const int o = offsets_[k];
+    for (int i = 0; i < count; ++i) {
+      const double* xi = x[i];
+      double* oi = out[i];
+      const Vec14 xq = gather_local(xi, c.bi, c.bj), xv = gather_local(xi + nq_, c.bi, c.bj);
+      Vec14 f1 = Vec14::Zero(), f2 = Vec14::Zero();
+      for (int r = 0; r < c.rows(); ++r) {
+        const Vec14 hx = h[r] * xq;
+        const int row = o + r;
+        f1 += mu[row] * hx + xi[2 * nq_ + nc_ + row] * rows[r].transpose();  // sum mu H x_q + Phi_q^T x_mu
+        f2 += lambda[row] * hx + xi[2 * nq_ + row] * rows[r].transpose();  // sum lambda H x_q + Phi_q^T x_lambda
+        oi[2 * nq_ + row] += scale_ * rows[r].dot(xq);                       // F3: s Phi_q x_q
+        oi[2 * nq_ + nc_ + row] += scale_ * (rows[r].dot(xv) + vl.dot(hx));  // F4: s (Phi_q x_v + (H v)^T x_q)
+      }
+      for (int l = 0; l < 14; ++l) {
+        const int g = global_index(c.bi, c.bj, l);
+        if (g < 0) continue;
+        oi[g] += f1[l];
+        oi[nq_ + g] += f2[l];
+      }
+    }
+  }
+}
+
 void GglDae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ || (v_in_test_ && i < 2 * nq_) ? 1.0 : 0.0;
 }

@@ -48,7 +48,12 @@ class GglDae : public MultibodyDae {
   // rtol|lambda| + m_ref (atol + noise/h)/h.
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
   std::string component_name(int i) const override;
-
+  // F_y x[i] without the assembly: the kinematic, force and inertia terms by the assembling
+  // code's product pass, each constraint's rows and row Hessians once for Phi_q, Phi_q^T and the
+  // three Hessian terms (sum mu_k H_k, sum lambda_k H_k, (H_k v)^T) of every x[i]; the
+  // assembly computes the Hessians five times for a three-row constraint and stores the matrix.
+  void jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
+                      double* const* out) override;
 
   bool velocities_error_tested() const override { return v_in_test_; }
 

@@ -45,6 +45,13 @@ void MultibodyDae::derivative_times(const double* y, const double* x, double* ou
   std::fill(out + 2 * nq_, out + size(), 0.0);
 }
 
+void MultibodyDae::jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
+                                  double* const* out) {
+  asm_.begin_product(count, x, out);
+  assemble(input_time(t), 0.0, y, yp);
+  asm_.end_product();
+}
+
 void MultibodyDae::record_pattern() {
   work_.resize(size());
   std::vector<double> y(size(), 0.0), yp(size(), 0.0);

@@ -80,6 +80,12 @@ class MultibodyDae : public DaeProblem {
   // formulation's F is affine in y'): the shared rows' x_q (F1) and M(q) x_v (F2), zero for the
   // formulation's own rows unless it overrides this (Index1Dae: its rows hold Phi_q v').
   virtual void derivative_times(const double* y, const double* x, double* out);
+  // out[i] += F_y x[i] for i < count, F_y the Newton matrix at cj = 0 at (t, y, y'), without
+  // assembling it: the assembling code in a product pass (SparseAssembler::begin_product), or a
+  // formulation's own products (GglDae: each constraint's rows and row Hessians computed once
+  // for all its uses and all x). The sensitivities' F_y s (formulation/twin_sensitivities.h).
+  virtual void jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
+                              double* const* out);
   // Output state from an interpolated (y, y'): optionally projected onto the constraint
   // manifold (positions and velocities), then the accelerations solved from it. Returns the
   // position violation of the interpolated y. (Same contract as Index3Dae::consistent_output.)

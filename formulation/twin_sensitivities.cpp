@@ -14,7 +14,6 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
     : run_(run), base_(std::move(base)), twins_(std::move(twins)), in_error_test_(in_error_test) {
   const int n = run_.size();
   if (!base_ || base_->size() != n) throw std::invalid_argument("TwinSensitivities: a base of another size");
-  a0_.resize(base_->jacobian_pattern().nnz());
   breakpoints_ = run_.breakpoints();
   for (ParameterTwins& p : twins_) {
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
@@ -74,12 +73,10 @@ void TwinSensitivities::jump_at_breakpoint(double t, const double* yp_before, co
 int TwinSensitivities::residual(double t, const double* y, const double* yp, const double*, const double* const* s,
                                 const double* const* sp, double* const* r) {
   follow(*base_);
-  base_->jacobian(t, 0.0, y, yp, a0_.data());  // one assembly for all parameters
-  for (size_t i = 0; i < twins_.size(); ++i) {
-    base_->derivative_times(y, sp[i], r[i]);
-    add_assembled_state_term(s[i], r[i]);
+  for (size_t i = 0; i < twins_.size(); ++i) base_->derivative_times(y, sp[i], r[i]);
+  base_->jacobian_times(t, y, yp, count(), s, r);  // one pass over the kernels for all parameters
+  for (size_t i = 0; i < twins_.size(); ++i)
     if (const int flag = add_parameter_difference(t, y, yp, twins_[i], r[i]); flag != 0) return flag;
-  }
   return 0;
 }
 
@@ -95,13 +92,6 @@ int TwinSensitivities::add_parameter_difference(double t, const double* y, const
   }
   for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
   return 0;
-}
-
-// r += A0 s.
-void TwinSensitivities::add_assembled_state_term(const double* s, double* r) const {
-  const CscPattern& pat = base_->jacobian_pattern();
-  for (int c = 0; c < run_.size(); ++c)
-    for (int k = pat.colptr[c]; k < pat.colptr[c + 1]; ++k) r[pat.rowind[k]] += a0_[k] * s[c];
 }
 
 void TwinSensitivities::initial(double, const double*, const double*, double* const* s, double* const* sp) {

@@ -6,8 +6,9 @@
 //
 //   F_y s + F_y' s' + F_p  =  A0 s  +  F_y' s'  +  [F+(y, y') - F-(y, y')] / (2 d),
 //
-// A0 = F_y the formulation's own Newton matrix at cj = 0 (exact, one assembly per call for all
-// parameters, on a copy of the run's DAE); F_y' s' exact, from the formulation
+// A0 = F_y the formulation's own Newton matrix at cj = 0, A0 s exact without assembling it
+// (MultibodyDae::jacobian_times: one pass over the kernels per call for all parameters, on a
+// copy of the run's DAE; until 2026-11-28 A0 was assembled at every call); F_y' s' exact, from the formulation
 // (MultibodyDae::derivative_times: every formulation's F is affine in y', F_y' holds the
 // identity, the mass matrix and index1's Phi_q); F_p the twins' central difference at the same
 // (y, y'), where the terms that do not depend on p are evaluated bit for bit alike and cancel,
@@ -71,14 +72,12 @@ class TwinSensitivities : public SensitivityProblem {
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
   int add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
-  void add_assembled_state_term(const double* s, double* r) const;
 
   int run_breakpoint(double t) const;  // the index of t among the run's breakpoints, or -1
 
   MultibodyDae& run_;
   std::vector<double> breakpoints_;  // the run's
   std::unique_ptr<MultibodyDae> base_;
-  std::vector<double> a0_;  // the Newton matrix's values at cj = 0: F_y
   std::vector<ParameterTwins> twins_;
   bool in_error_test_;
   std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)

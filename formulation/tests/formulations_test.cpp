@@ -114,6 +114,52 @@ TEST(Formulations, DerivativeTimesIsTheResidualsDerivativeInYp) {
   }
 }
 
+// F_y x without the assembly (MultibodyDae::jacobian_times, the sensitivities' F_y s) against the
+// assembled Newton matrix at cj = 0 times x: every formulation, two x at once, added to what
+// out holds, the wheel in contact and out of it.
+TEST(Formulations, JacobianTimesIsTheAssembledMatrixAtCjZeroTimesX) {
+  const System sys = build_system(testing::all_types_model());
+  Index3Dae i3(sys, 3.0, true);
+  GglDae ggl(sys, 7.0);
+  Index1Dae i1(sys, 5.0, BaumgarteParameters{10.0, 20.0});
+  Index1Dae pen(sys, 5.0, BaumgarteParameters{10.0, 20.0}, false, 1e7);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (MultibodyDae* dae : std::vector<MultibodyDae*>{&i3, &ggl, &i1, &pen})
+    for (char mode : {0, 1}) {
+      for (auto& m : dae->state().modes) m = mode;
+      const int n = dae->size();
+      std::vector<double> y, yp, values(dae->jacobian_pattern().nnz());
+      testing::dae_vectors(random_state(sys, 7), n, dae == &ggl, y, yp);
+      std::vector<double> x[2], out[2], ref[2];
+      for (int i = 0; i < 2; ++i) {
+        x[i].resize(n);
+        out[i].resize(n);
+        ref[i].assign(n, 0.0);
+        for (double& v : x[i]) v = u(rng);
+        for (double& v : out[i]) v = u(rng);
+      }
+      ASSERT_EQ(dae->jacobian(0.3, 0.0, y.data(), yp.data(), values.data()), 0);
+      const double* xs[2] = {x[0].data(), x[1].data()};
+      double* outs[2] = {out[0].data(), out[1].data()};
+      const std::vector<double> before[2] = {out[0], out[1]};
+      dae->jacobian_times(0.3, y.data(), yp.data(), 2, xs, outs);
+      double worst = 0, largest = 0;
+      for (int i = 0; i < 2; ++i) {
+        csc_multiply(dae->jacobian_pattern(), values.data(), x[i].data(), ref[i].data());
+        for (int k = 0; k < n; ++k) {
+          const double got = out[i][k] - before[i][k];
+          worst = std::max(worst, std::fabs(got - ref[i][k]) / (1 + std::fabs(ref[i][k])));
+          largest = std::max(largest, std::fabs(ref[i][k]));
+        }
+      }
+      std::printf("  F_y x of a %d-unknown DAE (wheel %s): largest %.3g, worst relative difference %.2e\n", n,
+                  mode ? "in contact" : "off", largest, worst);
+      EXPECT_LT(worst, 1e-12);
+      EXPECT_GT(largest, 1.0);
+    }
+}
+
 TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
   const System sys = build_system(testing::all_types_model());
   const double scale = 7.0;
