@@ -57,13 +57,9 @@ void SparseAssembler::end_product() {
   product_count_ = 0;
 }
 
-void SparseAssembler::other_add(int row, int col, double v) {
-  if (recording_) {
-    trows_.push_back(row);
-    tcols_.push_back(col);
-    return;
-  }
-  for (int i = 0; i < product_count_; ++i) product_out_[i][row] += v * product_x_[i][col];
+void SparseAssembler::record(int row, int col) {
+  trows_.push_back(row);
+  tcols_.push_back(col);
 }
 
 void SparseAssembler::begin_values(double* values) {

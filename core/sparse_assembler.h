@@ -39,7 +39,11 @@ class SparseAssembler {
 
   void add(int row, int col, double v) {
     if (other_mode_) {  // recording a pattern or multiplying
-      other_add(row, col, v);
+      if (recording_) {
+        record(row, col);
+        return;
+      }
+      for (int i = 0; i < product_count_; ++i) product_out_[i][row] += v * product_x_[i][col];
       return;
     }
     if (cursor_ < calls_.size() && calls_[cursor_].row == row && calls_[cursor_].col == col) {
@@ -60,7 +64,7 @@ class SparseAssembler {
     int row, col, slot;  // the recorded add() and its position in the value array
   };
   void mismatch(int row, int col);
-  void other_add(int row, int col, double v);
+  void record(int row, int col);
   bool recording_ = false;
   bool other_mode_ = false;  // recording_ or a product pass
   int product_count_ = 0;

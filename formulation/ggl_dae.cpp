@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "formulation/constraint_rates.h"
+#include "formulation/constraints.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -47,6 +48,22 @@ void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
   assemble_hessian_vector_rows(sys_, offsets_, q, v, scale_, nullptr, 0.0, rw, cq, asm_);
 }
 
+namespace {
+// H x for a constraint row's local Hessian; without position entries (!touches_r) only its
+// two 4 x 4 rotation blocks' rows and columns (the assembly leaves the rest out as well).
+Vec14 hessian_times(const Mat14& h, const Vec14& x, bool touches_r) {
+  if (touches_r) return h.lazyProduct(x);
+  static constexpr int kRot[8] = {3, 4, 5, 6, 10, 11, 12, 13};
+  Vec14 out = Vec14::Zero();
+  for (int a : kRot) {
+    double sum = 0;
+    for (int b : kRot) sum += h(a, b) * x[b];
+    out[a] = sum;
+  }
+  return out;
+}
+}  // namespace
+
 void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int count, const double* const* x,
                             double* const* out) {
   const double t = input_time(t_in);
@@ -68,6 +85,7 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
     const LocalState s = gather(q, c.bi, c.bj);
     constraint_jacobian(c, s, rows);
     row_hessians(c, s, h);
+    const bool touches_r = constraint_hessian_touches_r(c);
     const Vec14 vl = gather_local(v, c.bi, c.bj);
     const int o = offsets_[k];
     for (int i = 0; i < count; ++i) {
@@ -76,7 +94,7 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
       const Vec14 xq = gather_local(xi, c.bi, c.bj), xv = gather_local(xi + nq_, c.bi, c.bj);
       Vec14 f1 = Vec14::Zero(), f2 = Vec14::Zero();
       for (int r = 0; r < c.rows(); ++r) {
-        const Vec14 hx = h[r] * xq;
+        const Vec14 hx = hessian_times(h[r], xq, touches_r);
         const int row = o + r;
         f1 += mu[row] * hx + xi[2 * nq_ + nc_ + row] * rows[r].transpose();  // sum mu H x_q + Phi_q^T x_mu
         f2 += lambda[row] * hx + xi[2 * nq_ + row] * rows[r].transpose();  // sum lambda H x_q + Phi_q^T x_lambda

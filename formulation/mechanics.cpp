@@ -71,14 +71,31 @@ void generalized_forces(const System& sys, const std::vector<char>& modes, const
   }
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
-    Vec14 ql = Vec14::Zero();
-    const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);
-    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr, &in);
+    const Vec14 ql = force_local(sys, k, modes, q, v, t, turns);
     for (int l = 0; l < 14; ++l) {
       const int g = global_index(f.bi, f.bj, l);
       if (g >= 0) out[g] += ql[l];
     }
   }
+}
+
+Vec14 force_local(const System& sys, size_t k, const std::vector<char>& modes, const double* q, const double* v,
+                  double t, const CoordinateTurns* turns) {
+  const Force& f = sys.forces[k];
+  Vec14 ql = Vec14::Zero();
+  const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);
+  force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, nullptr, nullptr, &in);
+  return ql;
+}
+
+void body_momentum(const System& sys, int b, const double* q, const double* v, const double* acc, double* out) {
+  const SystemBody& body = sys.bodies[b];
+  const double* a = acc + 7 * b;
+  for (int k = 0; k < 3; ++k) out[k] = body.mass * (a[k] - sys.gravity[k]);
+  const Vec4 p = p_of(q, b), pd = p_of(v, b);
+  const Mat34 l = L_matrix(p);
+  Eigen::Map<Vec4>(out + 3) = 4.0 * l.transpose() * (body.inertia * (l * Eigen::Map<const Vec4>(a + 3))) +
+                              8.0 * L_matrix(pd).transpose() * (body.inertia * (l * pd));
 }
 
 void constraint_values(const System& sys, const std::vector<int>& off, const double* q, double t,

@@ -30,6 +30,13 @@ void mass_times(const System& sys, const double* q, const double* a, double* out
 // `turns`: the run's whole turns of rotation coordinates (system.h; null: nearest to the initial values).
 void generalized_forces(const System& sys, const std::vector<char>& modes, const double* q,
                         const double* v, double t, double* out, const CoordinateTurns* turns = nullptr);
+// Force k's generalized force on its two bodies' local coordinates [ri, pi, rj, pj] (the term
+// generalized_forces() adds for it).
+Vec14 force_local(const System& sys, size_t k, const std::vector<char>& modes, const double* q, const double* v,
+                  double t, const CoordinateTurns* turns = nullptr);
+// Body b's own rows of M(q) acc - Q: its inertia times acc, minus its weight and gyroscopic
+// terms (7 values; the applied forces and constraint forces left out).
+void body_momentum(const System& sys, int b, const double* q, const double* v, const double* acc, double* out);
 // Stacked constraint values Phi(q, t).
 void constraint_values(const System& sys, const std::vector<int>& offsets, const double* q,
                        double t, double* phi);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "formulation/mechanics.h"
 #include "formulation/sensors.h"
 
 namespace mbdae {
@@ -18,6 +19,7 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
   for (ParameterTwins& p : twins_) {
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
       throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
+    p.reach = parameter_reach(run_.system(), p.plus->system(), p.minus->system());
     p.breakpoints_plus = p.plus->breakpoints();
     p.breakpoints_minus = p.minus->breakpoints();
     if (p.breakpoints_plus.size() != breakpoints_.size() || p.breakpoints_minus.size() != breakpoints_.size())
@@ -84,6 +86,7 @@ int TwinSensitivities::residual(double t, const double* y, const double* yp, con
 // two residuals (every term that does not depend on p is alike in both and cancels).
 int TwinSensitivities::add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p,
                                                 double* r) {
+  if (p.reach.local && !p.whole_residuals) return add_reached_difference(t, y, yp, p, r);
   const int n = run_.size();
   for (int sign = 1; sign >= -1; sign -= 2) {
     MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
@@ -91,6 +94,38 @@ int TwinSensitivities::add_parameter_difference(double t, const double* y, const
     if (const int flag = twin.residual(t, y, yp, sign > 0 ? rp_.data() : rm_.data()); flag != 0) return flag;
   }
   for (int k = 0; k < n; ++k) r[k] += (rp_[k] - rm_[k]) * (0.5 / p.delta);
+  return 0;
+}
+
+// The same difference over the terms p reaches: the listed bodies' rows of M v' - Q (weight,
+// gyroscopic) and the listed forces' -Q, each twin's at the run's (y, y').
+int TwinSensitivities::add_reached_difference(double t, const double* y, const double* yp, ParameterTwins& p,
+                                              double* r) {
+  const int nq = run_.nq();
+  const double* v = y + nq;
+  double* f2 = r + nq;
+  const double f = 0.5 / p.delta;
+  follow(*p.plus);
+  follow(*p.minus);
+  const System &sp = p.plus->system(), &sm = p.minus->system();
+  for (int b : p.reach.bodies) {
+    double op[7], om[7];
+    body_momentum(sp, b, y, v, yp + nq, op);
+    body_momentum(sm, b, y, v, yp + nq, om);
+    for (int k = 0; k < 7; ++k) f2[7 * b + k] += (op[k] - om[k]) * f;
+  }
+  const double tp = p.plus->input_time(t), tm = p.minus->input_time(t);
+  for (int k : p.reach.forces) {
+    const Vec14 qp = force_local(sp, k, p.plus->state().modes, y, v, tp, &p.plus->state().turns);
+    const Vec14 qm = force_local(sm, k, p.minus->state().modes, y, v, tm, &p.minus->state().turns);
+    const Force& fo = sp.forces[k];
+    for (int l = 0; l < 14; ++l) {
+      const int g = global_index(fo.bi, fo.bj, l);
+      if (g >= 0) f2[g] -= (qp[l] - qm[l]) * f;
+    }
+  }
+  for (int i = 0; i < nq; ++i)
+    if (!std::isfinite(f2[i])) return 1;  // recoverable, as a twin's non-finite residual
   return 0;
 }
 

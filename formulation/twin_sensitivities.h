@@ -17,6 +17,10 @@
 // twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), with A0 only after its failures:
 // its truncation, d^2 times the third derivative along (s, 1), put A05's sensitivities 1.8e-1
 // off (docs/sensitivities.md, Method).
+// F_p takes two whole residuals of the twins only where the parameter reaches more than bodies'
+// inertia and forces (formulation/parameter_reach.h: a constraint, a point); a force's stiffness,
+// a body's mass or gravity difference just those terms, the same central difference without the
+// cancelling rest.
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 // A parameter that moves a breakpoint t_b (the time of an input's jump: a ground step, a point
@@ -32,6 +36,7 @@
 
 #include "core/sensitivity_problem.h"
 #include "formulation/multibody_dae.h"
+#include "formulation/parameter_reach.h"
 
 namespace mbdae {
 
@@ -42,6 +47,10 @@ struct ParameterTwins {
   // Each twin's consistent initial (y, y') from its own chain of analyses.
   std::vector<double> y_plus, yp_plus, y_minus, yp_minus;
   std::vector<double> breakpoints_plus, breakpoints_minus;  // each twin's (set by TwinSensitivities)
+  // The residual terms p reaches (set by TwinSensitivities); whole_residuals: F_p from the twins'
+  // whole residuals whatever the reach (a check of the reach).
+  ParameterReach reach;
+  bool whole_residuals = false;
 };
 
 class TwinSensitivities : public SensitivityProblem {
@@ -72,6 +81,7 @@ class TwinSensitivities : public SensitivityProblem {
  private:
   void follow(MultibodyDae& twin);  // the run's modes and turns
   int add_parameter_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
+  int add_reached_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
 
   int run_breakpoint(double t) const;  // the index of t among the run's breakpoints, or -1
 

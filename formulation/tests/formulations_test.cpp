@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <random>
 
 #include "core/ida_driver.h"
@@ -24,6 +26,7 @@
 #include "formulation/redundancy.h"
 #include "formulation/system.h"
 #include "formulation/tolerance_scales.h"
+#include "formulation/twin_sensitivities.h"
 #include "formulation/tests/integrate_model.h"
 #include "formulation/tests/test_models.h"
 
@@ -158,6 +161,69 @@ TEST(Formulations, JacobianTimesIsTheAssembledMatrixAtCjZeroTimesX) {
       EXPECT_LT(worst, 1e-12);
       EXPECT_GT(largest, 1.0);
     }
+}
+
+// F_p over the terms a parameter reaches (formulation/parameter_reach.h) against the twins' whole
+// residuals: the sensitivity residual at s = s' = 0 is F_p. Force numbers (a spring's, a user
+// law's, the tyre's), a mass, an inertia and gravity reach bodies and forces only; a centre of
+// mass moves the constraints' points and takes the whole residuals.
+TEST(Formulations, ReachedParameterDifferenceIsTheWholeResidualsDifference) {
+  const Model base = testing::all_types_model();
+  const System sys = build_system(base);
+  struct Case {
+    const char* what;
+    std::function<void(Model&, double)> set;
+    bool local;
+  };
+  const std::vector<Case> cases = {
+      {"spring stiffness", [](Model& m, double d) { m.forces[0].stiffness += d; }, true},
+      {"user law parameter", [](Model& m, double d) { m.forces[3].parameters["stiffness"] += d; }, true},
+      {"tyre radius", [](Model& m, double d) { m.forces[2].radius += d; }, true},
+      {"mass of a", [](Model& m, double d) { m.bodies[0].mass += d; }, true},
+      {"inertia of b", [](Model& m, double d) { m.bodies[1].inertia(0, 0) += d; }, true},
+      {"gravity z", [](Model& m, double d) { m.gravity[2] += d; }, true},
+      {"centre of mass of b", [](Model& m, double d) { m.bodies[1].com[0] += d; }, false}};
+  std::vector<double> y, yp;
+  testing::dae_vectors(random_state(sys, 9), 2 * sys.nq() + 2 * sys.num_constraint_rows(), true, y, yp);
+  for (const Case& c : cases) {
+    const double d = 1e-4;
+    std::vector<std::unique_ptr<System>> systems;
+    auto twin_of = [&](double delta) {
+      Model m = base;
+      c.set(m, delta);
+      systems.push_back(std::make_unique<System>(build_system(m)));
+      return std::make_unique<GglDae>(*systems.back(), 7.0);
+    };
+    std::vector<double> r[2];
+    bool local = false;
+    for (int whole = 0; whole < 2; ++whole) {
+      GglDae run(sys, 7.0);
+      std::vector<ParameterTwins> twins(1);
+      twins[0].plus = twin_of(d);
+      twins[0].minus = twin_of(-d);
+      twins[0].delta = d;
+      twins[0].whole_residuals = whole == 1;
+      for (auto& m : run.state().modes) m = 1;  // the tyre in contact
+      TwinSensitivities ts(run, std::make_unique<GglDae>(sys, 7.0), std::move(twins), true);
+      local = ts.twins(0).reach.local;
+      const int n = run.size();
+      std::vector<double> zero(n, 0.0);
+      r[whole].assign(n, 0.0);
+      const double* s[1] = {zero.data()};
+      double* out[1] = {r[whole].data()};
+      ASSERT_EQ(ts.residual(0.3, y.data(), yp.data(), nullptr, s, s, out), 0);
+    }
+    double worst = 0, largest = 0;
+    for (size_t k = 0; k < r[0].size(); ++k) {
+      worst = std::max(worst, std::fabs(r[0][k] - r[1][k]));
+      largest = std::max(largest, std::fabs(r[1][k]));
+    }
+    std::printf("  F_p of the %s (%s): largest %.3g, reached against whole %.2e\n", c.what,
+                local ? "reached terms" : "whole residuals", largest, worst);
+    EXPECT_EQ(local, c.local) << c.what;
+    EXPECT_GT(largest, 1e-2) << c.what;
+    EXPECT_LT(worst, 1e-8 * largest) << c.what;
+  }
 }
 
 TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
