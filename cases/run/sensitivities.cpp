@@ -14,6 +14,7 @@
 #include "core/finite_check.h"
 #include "formulation/mechanics.h"  // initial_modes
 #include "formulation/model_rules.h"  // did_you_mean
+#include "formulation/parameter_reach.h"
 #include "formulation/kinematic_sensitivities.h"
 #include "formulation/tolerance_scales.h"
 #include "formulation/twin_sensitivities.h"
@@ -386,6 +387,19 @@ NormalizedSensitivities normalized_sensitivities(const Result& r) {
   return out;
 }
 
+// How F_p is formed for p (formulation/parameter_reach.h), for summary.json.
+std::string reach_text(const System& sys, const SensitivityParameter& p) {
+  const ParameterReach r = parameter_reach(sys, *p.twin[0]->context->system, *p.twin[1]->context->system);
+  if (!r.local) return "the twins' whole residuals (the parameter reaches a constraint or a point)";
+  std::string out = "the terms it may reach:";
+  for (int b : r.bodies) out += " body " + sys.bodies[b].name + ",";
+  for (int k : r.forces) out += " force " + sys.forces[k].name + ",";
+  if (r.bodies.empty() && r.forces.empty()) return "zero (the parameter reaches no term of the dynamics' residual)";
+  out.back() = ' ';
+  out.pop_back();
+  return out;
+}
+
 void close_sensitivities(RunContext& c) {
   if (!c.sensitivities) return;
   const RunSensitivities& rs = *c.sensitivities;
@@ -393,6 +407,7 @@ void close_sensitivities(RunContext& c) {
   for (const SensitivityParameter& p : rs.parameters) {
     params.push_back({{"path", p.path}, {"value", p.value}, {"unit", p.unit}, {"difference_step", p.delta}});
     if (!p.moved_breakpoints.empty()) params.back()["moves_breakpoints"] = p.moved_breakpoints;
+    params.back()["residual_derivative"] = reach_text(*c.system, p);
   }
   json columns = json::array();
   for (size_t k = 0; k < c.result.sensitivity_columns.size(); ++k)
@@ -400,8 +415,9 @@ void close_sensitivities(RunContext& c) {
   json j;
   j["method"] = "IDAS forward sensitivities (staggered corrector on the run's Newton matrix; sensitivities in the "
                 "local error test, their tolerances at least 1e-9 of the state's size, out of it for windows after a "
-                "failure there); F_y from the formulation's Newton matrix at cj = 0; F_p, consistent initial values and "
-                "sensors by central differences over twin models at p +- d (docs/sensitivities.md)";
+                "failure there); F_y s exact from the formulation without assembling F_y; F_p (over the terms each "
+                "parameter reaches), consistent initial values and sensors by central differences over twin models "
+                "at p +- d (docs/sensitivities.md)";
   j["parameters"] = params;
   j["columns"] = columns;
   j["rows"] = c.result.sensitivities.empty() ? 0 : c.result.sensitivities[0].size();
