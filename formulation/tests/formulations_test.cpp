@@ -83,20 +83,28 @@ TEST(Formulations, GglNewtonMatrixIsExact) {
   EXPECT_GT(fd.block(2 * nq + nc, 0, nc, nq).cwiseAbs().maxCoeff(), 1e-3);
 }
 
+// Each formulation on one system: index3, index2-ggl, index1 and penalty.
+struct EveryFormulation {
+  explicit EveryFormulation(const System& sys)
+      : i3(sys, 3.0, true), ggl(sys, 7.0), i1(sys, 5.0, BaumgarteParameters{10.0, 20.0}),
+        pen(sys, 5.0, BaumgarteParameters{10.0, 20.0}, false, 1e7) {}
+  std::vector<MultibodyDae*> all() { return {&i3, &ggl, &i1, &pen}; }
+  Index3Dae i3;
+  GglDae ggl;
+  Index1Dae i1, pen;
+};
+
 // F_y' x (MultibodyDae::derivative_times, the sensitivities' F_y' s') against the residual's own
 // central difference in y', exact for a residual affine in y': every formulation, every row.
 TEST(Formulations, DerivativeTimesIsTheResidualsDerivativeInYp) {
   const System sys = build_system(testing::all_types_model());
-  Index3Dae i3(sys, 3.0, true);
-  GglDae ggl(sys, 7.0);
-  Index1Dae i1(sys, 5.0, BaumgarteParameters{10.0, 20.0});
-  Index1Dae pen(sys, 5.0, BaumgarteParameters{10.0, 20.0}, false, 1e7);
+  EveryFormulation f(sys);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (MultibodyDae* dae : std::vector<MultibodyDae*>{&i3, &ggl, &i1, &pen}) {
+  for (MultibodyDae* dae : f.all()) {
     const int n = dae->size();
     std::vector<double> y, yp, x(n), ypp(n), ypm(n), rp(n), rm(n), out(n);
-    testing::dae_vectors(random_state(sys, 5), n, dae == &ggl, y, yp);
+    testing::dae_vectors(random_state(sys, 5), n, dae == &f.ggl, y, yp);
     for (double& v : x) v = u(rng);
     for (int i = 0; i < n; ++i) {
       ypp[i] = yp[i] + x[i];
@@ -122,18 +130,15 @@ TEST(Formulations, DerivativeTimesIsTheResidualsDerivativeInYp) {
 // out holds, the wheel in contact and out of it.
 TEST(Formulations, JacobianTimesIsTheAssembledMatrixAtCjZeroTimesX) {
   const System sys = build_system(testing::all_types_model());
-  Index3Dae i3(sys, 3.0, true);
-  GglDae ggl(sys, 7.0);
-  Index1Dae i1(sys, 5.0, BaumgarteParameters{10.0, 20.0});
-  Index1Dae pen(sys, 5.0, BaumgarteParameters{10.0, 20.0}, false, 1e7);
+  EveryFormulation f(sys);
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (MultibodyDae* dae : std::vector<MultibodyDae*>{&i3, &ggl, &i1, &pen})
+  for (MultibodyDae* dae : f.all())
     for (char mode : {0, 1}) {
       for (auto& m : dae->state().modes) m = mode;
       const int n = dae->size();
       std::vector<double> y, yp, values(dae->jacobian_pattern().nnz());
-      testing::dae_vectors(random_state(sys, 7), n, dae == &ggl, y, yp);
+      testing::dae_vectors(random_state(sys, 7), n, dae == &f.ggl, y, yp);
       std::vector<double> x[2], out[2], ref[2];
       for (int i = 0; i < 2; ++i) {
         x[i].resize(n);
