@@ -89,6 +89,23 @@ bool moves_inside_integrated_step(const RunContext& c, double b) {
   return false;
 }
 
+// The analysis step whose start or end (a static step's time: its t0) lies between the run's
+// breakpoint b and a twin's bt, or at either: there the run's start or end sees one side of the
+// input's jump and the twin the other, which has no derivative. Null if none.
+std::string step_span(const AnalysisStep& step) {
+  const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
+  return integrated ? "t = " + short_text(step.t0) + " to " + short_text(step.t_end) : "at t = " + short_text(step.t0);
+}
+
+const AnalysisStep* crossed_step(const RunContext& c, double b, double bt) {
+  for (const AnalysisStep& step : c.scene.steps) {
+    const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
+    for (const double x : {step.t0, step.t_end})
+      if ((integrated || x == step.t0) && (b - x) * (bt - x) <= 0) return &step;
+  }
+  return nullptr;
+}
+
 std::string breakpoint_refusal(const System& sys, const System& twin) {
   std::vector<double> drives, twin_drives;
   for (const Constraint& k : sys.constraints)
@@ -115,6 +132,13 @@ void check_breakpoints(const RunContext& c, SensitivityParameter& p) {
     for (size_t k = 0; k < std::max(own.size(), twin.size()); ++k) {
       const double b = k < own.size() ? own[k] : twin[k], bt = k < twin.size() ? twin[k] : NAN;
       if (k < own.size() && k < twin.size() && std::fabs(bt - b) <= 1e-14 * std::max(1.0, std::fabs(b))) continue;
+      if (const AnalysisStep* step = crossed_step(c, b, bt))
+        throw ModelError(c.scene.file, 0, "sensitivities",
+                         "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) +
+                             " with " + p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
+                             ") onto or across the start or end of analysis step " +
+                             std::to_string(step - c.scene.steps.data()) + " (" + step_span(*step) +
+                             "), where the input's two sides differ: it cannot be differentiated");
       if (!moves_inside_integrated_step(c, b)) continue;
       const std::string why = breakpoint_refusal(*c.system, twin_sys);
       if (why.empty()) {

@@ -142,8 +142,8 @@ TEST(SuspensionSensitivities, DynamicsIWheelAgainstTyreDampingAndMass) {
 
 // The ground step's time moves a breakpoint: the sensitivities jump there by (v'- - v'+) dt/dp
 // (formulation/twin_sensitivities.h), checked against central differences of rtol 1e-10 runs
-// (step 1e-5 s) before the step (zero), through it to the first lift-off and after. A drive's
-// knot time moves a breakpoint whose jump is not computed: refused, naming it.
+// (step 1e-5 s) before the step (zero), through it to the first lift-off and after. A step at the
+// run's end, and a drive's knot time (a breakpoint whose jump is not computed), are refused.
 TEST(SuspensionSensitivities, DynamicsIWheelAgainstTheGroundStepsTime) {
   const Scene s = scene("dynamics_step.yaml");
   RunOptions opt;
@@ -163,6 +163,14 @@ TEST(SuspensionSensitivities, DynamicsIWheelAgainstTheGroundStepsTime) {
     EXPECT_LT(before, 1e-12) << sensor;
     EXPECT_LT(through, 1e-4) << sensor;
     EXPECT_LT(after, 1e-4) << sensor;
+  }
+  // A step at the run's end: the twins' steps fall on both sides of it.
+  try {
+    run(with_parameters(s, {{"forces.tyre.ground.time", "1.5"}}), opt);
+    ADD_FAILURE() << "no error";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("onto or across the start or end of analysis step"), std::string::npos)
+        << e.what();
   }
   opt.sensitivities = {"coordinates.q4.drive.points.1.0"};
   try {
