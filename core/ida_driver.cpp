@@ -207,6 +207,8 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.t = r.t_prev = o.t0;
   r.y_prev = y0;
   r.yp_prev = yp0;
+  r.y_before = y0;
+  r.yp_before = yp0;
 }
 
 // A failure other than IDA's own (those: ida_failure) ends the run; the first one is kept.
@@ -370,13 +372,16 @@ bool restart(IdaRun& r, const int* roots) {
   while (r.next_bp < r.bps.size() && r.bps[r.next_bp] <= r.t) ++r.next_bp;
   r.problem->set_segment(r.t, segment_end(r));
   try {
+    if (r.sens_on) {  // the state before the restart: the sensitivities' restart maps it (with s) as the run's did
+      std::memcpy(r.y_before.data(), data(r.y), r.n * sizeof(double));
+      std::memcpy(r.yp_before.data(), data(r.yp), r.n * sizeof(double));
+    }
     r.problem->restart(r.t, data(r.y), data(r.yp), roots);
     if (r.sens_on) {  // the sensitivities at t (IDAS's), made consistent with the restarted state
       r.o->sensitivities->set_segment(r.t, segment_end(r));
       if (!interpolate_sensitivities(r, r.t, r.s, r.sp)) return false;
-      // keep_step() stored the derivative IDA reached the breakpoint with.
-      if (!roots) r.o->sensitivities->jump_at_breakpoint(r.t, r.yp_prev.data(), data(r.yp), r.s_data.data());
-      r.o->sensitivities->restart(r.t, data(r.y), data(r.yp), r.s_data.data(), r.sp_data.data());
+      if (!roots) r.o->sensitivities->jump_at_breakpoint(r.t, r.yp_before.data(), data(r.yp), r.s_data.data());
+      r.o->sensitivities->restart(r.t, r.y_before.data(), r.yp_before.data(), r.s_data.data(), r.sp_data.data());
     }
   } catch (const SolveError& e) {
     fail(r, e.status, std::string("restart at t = ") + std::to_string(r.t) + " failed: " + e.what(), r.t);

@@ -90,6 +90,7 @@ struct IdaRun {
   bool with_derivative = false;
   double t = 0, t_prev = 0;  // the current time and that of the last accepted step
   std::vector<double> y_prev, yp_prev;
+  std::vector<double> y_before, yp_before;  // the state a restart started from (the sensitivities' restart)
   IdaStats stats;
   long fresh_seen = 0;    // fresh Newton-matrix factorizations already passed to after_fresh_factorization
   long watch_steps = 0;  // steps since watch_t (the step budget, IdaOptions::max_total_steps)

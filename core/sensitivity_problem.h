@@ -24,8 +24,10 @@ class SensitivityProblem {
   virtual bool reads_state_residual() const { return true; }
   // Consistent (s[i], sp[i]) at the start, (y, y') consistent there. Throws SolveError.
   virtual void initial(double t, const double* y, const double* yp, double* const* s, double* const* sp) = 0;
-  // After the problem's restart at t made (y, y') consistent: consistent (s[i], sp[i]) from
-  // the s[i] before it. Throws SolveError on failure.
+  // After the problem's restart at t: consistent (s[i], sp[i]) from the s[i] before it, (y, y')
+  // the state the restart started from (at an impulsive restart, a drive's kink, the run's
+  // velocities jump, and the sensitivities follow the restart's map at that state). Throws
+  // SolveError on failure.
   virtual void restart(double t, const double* y, const double* yp, double* const* s, double* const* sp) = 0;
   // At a breakpoint t_b (an input's jump at a fixed time, DaeProblem::breakpoints), before
   // restart(): s[i] += (y'- - y'+) dt_b/dp_i on the differential unknowns, the jump that the

@@ -44,18 +44,22 @@ int TwinSensitivities::run_breakpoint(double t) const {
   return -1;
 }
 
-// A segment's ends that are the run's breakpoints become the twin's own; its inputs are held
-// from its own start where that lies after the run's.
+// A segment's end that is one of the run's breakpoints becomes the twin's own. The twin's inputs
+// are held from its own copy of the last breakpoint the run has passed, where that lies after
+// t_start: also when the segment starts at an event between the two (a landing 1 us after the
+// run's step, before the twin's).
 void TwinSensitivities::set_segment(double t_start, double t_end) {
   base_->set_segment(t_start, t_end);
-  const int ks = run_breakpoint(t_start), ke = run_breakpoint(t_end);
+  const int ke = run_breakpoint(t_end);
+  int passed = -1;  // the last of the run's breakpoints at or before t_start
+  for (size_t k = 0; k < breakpoints_.size(); ++k)
+    if (breakpoints_[k] <= t_start || static_cast<int>(k) == run_breakpoint(t_start)) passed = static_cast<int>(k);
   for (ParameterTwins& p : twins_)
     for (int side = 0; side < 2; ++side) {
       MultibodyDae& twin = side == 0 ? *p.plus : *p.minus;
       const std::vector<double>& b = side == 0 ? p.breakpoints_plus : p.breakpoints_minus;
-      const double start = ks >= 0 ? b[ks] : t_start;
-      twin.set_segment(start, ke >= 0 ? b[ke] : t_end);
-      twin.hold_inputs_from(start > t_start ? start : -1e300);
+      twin.set_segment(t_start, ke >= 0 ? b[ke] : t_end);
+      twin.hold_inputs_from(passed >= 0 && b[passed] > t_start ? b[passed] : -1e300);
     }
 }
 

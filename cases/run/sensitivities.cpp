@@ -115,45 +115,75 @@ std::string breakpoint_refusal(const System& sys, const System& twin) {
     if (k.type == Constraint::Type::kCoordinate)
       for (double b : k.target.breakpoints()) twin_drives.push_back(b);
   if (drives != twin_drives) return "a driven coordinate's breakpoint";
-  for (const Force& f : sys.forces)
+  for (const Force& f : sys.forces) {
     for (const TimeFunction* g : {&f.fx, &f.fy, &f.fz, &f.ground})
       if (g->kind != TimeFunction::Kind::kConstant && g->kind != TimeFunction::Kind::kStep)
         return "a model whose force '" + f.name + "' has an input that varies with time (" + g->describe() +
                "), which the twins cannot hold over their step (only a step can be)";
+    for (const Expression& e : f.expression)
+      if (!e.variables.empty() && e.variables.front() == 0)  // t is variable 0
+        return "a model whose force '" + f.name + "' has an expression of t, which the twins cannot hold over "
+               "their step (only a step can be)";
+    if (f.law)
+      return "a model with the user law '" + f.name + "' (" + f.law->name + "), which may read t, and the twins "
+             "cannot hold it over their step";
+  }
   if (sys.breakpoints().size() != twin.breakpoints().size()) return "breakpoints that appear, vanish or merge";
   return "";
 }
 
+double nearest(const std::vector<double>& ts, double t) {
+  double best = NAN;
+  for (const double x : ts)
+    if (!(std::fabs(x - t) >= std::fabs(best - t))) best = x;
+  return best;
+}
+
 void check_breakpoints(const RunContext& c, SensitivityParameter& p) {
   const std::vector<double> own = c.system->breakpoints();
+  auto same_time = [](double a, double b) { return std::fabs(a - b) <= 1e-14 * std::max(1.0, std::fabs(a)); };
   for (int side = 0; side < 2; ++side) {
     const System& twin_sys = *p.twin[side]->context->system;
     const std::vector<double> twin = twin_sys.breakpoints();
-    for (size_t k = 0; k < std::max(own.size(), twin.size()); ++k) {
-      const double b = k < own.size() ? own[k] : twin[k], bt = k < twin.size() ? twin[k] : NAN;
-      if (k < own.size() && k < twin.size() && std::fabs(bt - b) <= 1e-14 * std::max(1.0, std::fabs(b))) continue;
+    auto refuse = [&](double b, double bt, const std::string& what) {
+      throw ModelError(c.scene.file, 0, "sensitivities",
+                       "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" +
+                           (std::isfinite(bt) ? "to " + short_text(bt) + " " : "") + "with " + p.path + " = " +
+                           short_text(side == 0 ? p.value + p.delta : p.value - p.delta) + ") " + what +
+                           ": it cannot be differentiated");
+    };
+    if (twin.size() != own.size()) {  // two breakpoints merge or split: name the first unmatched
+      for (const double b : own)
+        if (std::none_of(twin.begin(), twin.end(), [&](double x) { return same_time(x, b); }))
+          refuse(b, NAN, "onto another breakpoint (its twin has " + std::to_string(twin.size()) + " breakpoints, the run " +
+                             std::to_string(own.size()) + ")");
+      for (const double bt : twin)
+        if (std::none_of(own.begin(), own.end(), [&](double x) { return same_time(x, bt); }))
+          refuse(nearest(own, bt), NAN, "so that it splits off another breakpoint (its twin has " + std::to_string(twin.size()) +
+                                            " breakpoints, the run " + std::to_string(own.size()) + ")");
+    }
+    for (size_t k = 0; k < own.size(); ++k) {
+      const double b = own[k], bt = twin[k];
+      if (same_time(b, bt)) continue;
       if (const AnalysisStep* step = crossed_step(c, b, bt))
-        throw ModelError(c.scene.file, 0, "sensitivities",
-                         "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) +
-                             " with " + p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
-                             ") onto or across the start or end of analysis step " +
-                             std::to_string(step - c.scene.steps.data()) + " (" + step_span(*step) +
-                             "), where the input's two sides differ: it cannot be differentiated");
+        refuse(b, bt, "onto or across the start or end of analysis step " + std::to_string(step - c.scene.steps.data()) +
+                          " (" + step_span(*step) + "), where the input's two sides differ");
+      // The twins' breakpoints matched to the run's by their order: a twin's must stay well
+      // inside its gaps (two steps 1e-5 s apart against a twins' step of 2e-5 s swapped them).
+      for (const size_t n : {k - 1, k + 1})
+        if (n < own.size() && std::fabs(bt - b) >= 0.5 * std::fabs(own[n] - b))
+          refuse(b, NAN, "to within half its distance of the breakpoint at t = " + short_text(own[n]) +
+                            " (closer than twice the twins' step)");
       if (!moves_inside_integrated_step(c, b)) continue;
       const std::string why = breakpoint_refusal(*c.system, twin_sys);
-      if (why.empty()) {
-        if (side == 0)
-          p.moved_breakpoints.push_back(
-              {{"t", b},
-               {"dt_dp", (bt - p.twin[1]->context->system->breakpoints()[k]) / (2 * p.delta)},
-               {"note", "the sensitivities jump there by (y'- - y'+) dt/dp on q and v (docs/sensitivities.md)"}});
-        continue;
-      }
-      throw ModelError(c.scene.file, 0, "sensitivities",
-                       "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" + short_text(bt) + " with " +
-                           p.path + " = " + short_text(side == 0 ? p.value + p.delta : p.value - p.delta) +
-                           ") inside an integrated step, and the sensitivities' jump there is computed only for a "
-                           "force's step: this is " + why + "; it cannot be differentiated");
+      if (!why.empty())
+        refuse(b, bt, "inside an integrated step, and the sensitivities' jump there is computed only for a force's "
+                      "step: this is " + why);
+      if (side == 0)
+        p.moved_breakpoints.push_back(
+            {{"t", b},
+             {"dt_dp", (bt - p.twin[1]->context->system->breakpoints()[k]) / (2 * p.delta)},
+             {"note", "the sensitivities jump there by (y'- - y'+) dt/dp on q and v (docs/sensitivities.md)"}});
     }
   }
 }
