@@ -308,8 +308,13 @@ double next_stop(const IdaRun& r) {
   return r.end_is_breakpoint ? o.t1 : o.t1 + (o.t1 - o.t0);
 }
 
-// Only a real breakpoint ends a segment: the end of the run is no jump of the inputs.
-double segment_end(const IdaRun& r) { return r.next_bp < r.bps.size() ? r.bps[r.next_bp] : 1e300; }
+// Only a real breakpoint ends a segment: the end of the run is no jump of the inputs unless a
+// breakpoint falls on it, where the last sample shows the inputs' left limit as every sample at
+// a breakpoint does (the run never goes past the jump).
+double segment_end(const IdaRun& r) {
+  if (r.next_bp < r.bps.size()) return r.bps[r.next_bp];
+  return r.end_is_breakpoint ? r.o->t1 : 1e300;
+}
 
 // The last accepted step (interpolated root states are never kept).
 void keep_step(IdaRun& r) {

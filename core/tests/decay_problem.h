@@ -73,6 +73,7 @@ class DecayProblem : public DaeProblem {
     return b;
   }
   void set_segment(double, double t_end) override { segment_end_ = t_end; }
+  double segment_end() const { return segment_end_; }
 
   double exact(double t) const {
     if (!step_input || t <= 0.5) return std::exp(-t);

@@ -96,6 +96,9 @@ TEST(IdaDriver, EndAtABreakpointIsAStopTime) {
   const IdaStats st = run(p, s, y);
   expect_follows_solution(p, s, y, st);
   EXPECT_EQ(st.breakpoint_times.size(), 1u);  // the end is no restart
+  // The last segment ends at the end's breakpoint: its inputs (and the last sample's) are the
+  // left limit there, as at every breakpoint.
+  EXPECT_EQ(p.segment_end(), 2.0);
 }
 
 TEST(IdaDriver, EventIsLocatedAndRestarted) {
