@@ -40,7 +40,8 @@ void TwinSensitivities::follow(MultibodyDae& twin) {
 
 int TwinSensitivities::run_breakpoint(double t) const {
   for (size_t k = 0; k < breakpoints_.size(); ++k)
-    if (std::fabs(t - breakpoints_[k]) <= 1e-12 * std::max(1.0, std::fabs(t))) return static_cast<int>(k);
+    if (std::fabs(t - breakpoints_[k]) <= 64 * 2.220446049250313e-16 * std::fabs(breakpoints_[k]))
+      return static_cast<int>(k);
   return -1;
 }
 

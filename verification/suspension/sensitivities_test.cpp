@@ -164,6 +164,16 @@ TEST(SuspensionSensitivities, DynamicsIWheelAgainstTheGroundStepsTime) {
     EXPECT_LT(through, 1e-4) << sensor;
     EXPECT_LT(after, 1e-4) << sensor;
   }
+  // The twins' step of an instant is the model's, not 3e-5 of the clock: the same with the step
+  // at 1 s (before 2026-11-28 it grew with the time, and a step at 50 s was 4.6e-4 off).
+  {
+    RunOptions quick = opt;
+    quick.analysis = 1;  // through the equilibrium only: the step is chosen before any stage
+    const Result later = run(with_parameters(s, {{"forces.tyre.ground.time", "1.0"}}), quick);
+    EXPECT_EQ(later.summary["sensitivities"]["parameters"][0]["difference_step"],
+              r.summary["sensitivities"]["parameters"][0]["difference_step"]);
+    EXPECT_LT(r.summary["sensitivities"]["parameters"][0]["difference_step"].get<double>(), 1e-6);
+  }
   // A step at the run's end: the twins' steps fall on both sides of it.
   try {
     run(with_parameters(s, {{"forces.tyre.ground.time", "1.5"}}), opt);
