@@ -4,6 +4,7 @@
 #include <set>
 
 #include "cases/scene/analysis_types.h"
+#include "cases/scene/field_ranges.h"  // format_number
 #include "core/errors.h"
 #include "formulation/force_types.h"
 #include "formulation/model_rules.h"
@@ -89,6 +90,22 @@ struct SceneRules : ModelNames {
     }
   }
 
+  // A driven coordinate whose value jumps (a step drive) inside a dynamics step: no motion
+  // follows a jump of a position, and the restart would move the free coordinates by a
+  // projection (a pendulum on a cart jumped 5 degrees). A ramp (piecewise_linear) is motion.
+  void check_position_jumps(const AnalysisStep& s) {
+    for (const auto& [name, c] : scene.model.coordinates) {
+      const TimeFunction& d = c.drive;
+      if (c.mode != CoordinateSpec::Mode::kDriven || d.kind != TimeFunction::Kind::kStep || d.a == d.b) continue;
+      if (d.t0 > s.t0 && d.t0 < s.t_end)
+        report(c.where, "drive",
+               "coordinate '" + name + "' is driven by a step (from " + format_number(d.a) + " to " + format_number(d.b) +
+                   " at t = " + format_number(d.t0) + ") inside a dynamics step (t = " + format_number(s.t0) + " to " +
+                   format_number(s.t_end) + "): no motion follows a jump of a position; drive it by a ramp "
+                   "(piecewise_linear)");
+    }
+  }
+
   void check_steps() {
     for (const auto& s : scene.steps) {
       using A = AnalysisStep::Type;
@@ -148,6 +165,7 @@ struct SceneRules : ModelNames {
           if (!seen.insert(n).second) report(s.where, f, "coordinate '" + n + "' is listed twice");
         }
       }
+      if (s.type == A::kDynamics) check_position_jumps(s);
       if (integrates(s))
         for (size_t k = 0; k < s.quiet_sensors.size(); ++k)
           if (!sensor_index.count(s.quiet_sensors[k]))

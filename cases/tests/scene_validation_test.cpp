@@ -389,6 +389,20 @@ TEST(SceneValidation, InitialVelocityOfDrivenCoordinate) {
   expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "coordinate 'theta' is driven");
 }
 
+// A step drive (a jump of a position) inside a dynamics step is no motion; at the step's start,
+// or as a ramp, it is.
+TEST(SceneValidation, StepDriveInsideADynamicsStep) {
+  std::string t = with("theta: {initial_deg: 30}",
+                       "theta: {initial_deg: 30, mode: driven, drive: {type: step, time: 0.5, before: 0.5, after: 0.6}}");
+  t = with("  - {type: equilibrium, hold: [theta], release: [theta], unknowns: [spring.free_length]}\n", "", t);
+  expect_one(t, line_of(t, "mode: driven"), "drive", "coordinate 'theta' is driven by a step (from 0.5 to 0.6 at t = 0.5) "
+                                                     "inside a dynamics step (t = 0 to 1)");
+  EXPECT_NO_THROW(load_scene_text(with("time: 0.5,", "time: 0.0,", t), kFile));
+  EXPECT_NO_THROW(load_scene_text(with("{type: step, time: 0.5, before: 0.5, after: 0.6}",
+                                       "{type: piecewise_linear, points: [[0.5, 0.5], [0.6, 0.6]]}", t),
+                                  kFile));
+}
+
 TEST(SceneValidation, InitialVelocitiesOnlyForDynamics) {
   const std::string t = with("{type: assembly}", "{type: assembly, initial_velocities: {theta: 1.0}}");
   expect_one(t, line_of(t, "initial_velocities"), "initial_velocities", "does not apply to");
