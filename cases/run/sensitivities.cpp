@@ -77,10 +77,11 @@ std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParamet
 // A parameter that moves the time of a breakpoint inside an integrated step: the twins keep
 // their own breakpoints and the sensitivities jump at the run's (formulation/twin_sensitivities.h).
 // That holds for a force's step (a ground profile's, a point force's): q and v continuous, v'
-// jumping. Refused, naming the breakpoint: a drive's breakpoint (a kink or jump of a
-// constraint's target moves q or v themselves), breakpoints that appear, vanish or merge, and
-// any other input that varies with time (each twin holds its inputs over the d between its
-// breakpoint and the run's, which is exact for steps only).
+// jumping. Refused, naming the breakpoint (check_breakpoints): a drive's breakpoint (a kink or
+// jump of a constraint's target moves q or v themselves), breakpoints that appear, vanish, merge
+// or come within twice the twins' step of each other, one moved onto an analysis step's start or
+// end, and any other input that varies with time (each twin holds its inputs over the d between
+// its breakpoint and the run's, which is exact for steps only).
 bool moves_inside_integrated_step(const RunContext& c, double b) {
   for (const AnalysisStep& step : c.scene.steps) {
     const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
@@ -89,14 +90,14 @@ bool moves_inside_integrated_step(const RunContext& c, double b) {
   return false;
 }
 
-// The analysis step whose start or end (a static step's time: its t0) lies between the run's
-// breakpoint b and a twin's bt, or at either: there the run's start or end sees one side of the
-// input's jump and the twin the other, which has no derivative. Null if none.
 std::string step_span(const AnalysisStep& step) {
   const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
   return integrated ? "t = " + short_text(step.t0) + " to " + short_text(step.t_end) : "at t = " + short_text(step.t0);
 }
 
+// The analysis step whose start or end (a static step's time: its t0) lies between the run's
+// breakpoint b and a twin's bt, or at either: there the run's start or end sees one side of the
+// input's jump and the twin the other, which has no derivative. Null if none.
 const AnalysisStep* crossed_step(const RunContext& c, double b, double bt) {
   for (const AnalysisStep& step : c.scene.steps) {
     const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
