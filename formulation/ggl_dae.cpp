@@ -192,6 +192,28 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
   }
 }
 
+void GglDae::constraint_terms(double t_in, const double* y, int k, ConstraintTerms& out) const {
+  const double t = input_time(t_in);
+  const Constraint& c = sys_.constraints[k];
+  const LocalState s = gather(y, c.bi, c.bj);
+  Row14 rows[3];
+  double phi[3], phi_t[3], phi_tt[3];
+  constraint_jacobian(c, s, rows);
+  constraint_value(c, s, t, phi);
+  constraint_time_derivatives(c, t, phi_t, phi_tt);
+  const Vec14 vl = gather_local(y + nq_, c.bi, c.bj);
+  const double* lambda = y + 2 * nq_ + offsets_[k];
+  const double* mu = y + 2 * nq_ + nc_ + offsets_[k];
+  out.f1.setZero();
+  out.f2.setZero();
+  for (int r = 0; r < c.rows(); ++r) {
+    out.f1 += mu[r] * rows[r].transpose();
+    out.f2 += lambda[r] * rows[r].transpose();
+    out.rows[0][r] = scale_ * phi[r];
+    out.rows[1][r] = scale_ * (rows[r].dot(vl) + phi_t[r]);
+  }
+}
+
 void GglDae::error_test_mask(double* id) const {
   for (int i = 0; i < size(); ++i) id[i] = i < nq_ || (v_in_test_ && i < 2 * nq_) ? 1.0 : 0.0;
 }

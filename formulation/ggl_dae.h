@@ -54,6 +54,10 @@ class GglDae : public MultibodyDae {
   // assembly computes the Hessians five times for a three-row constraint and stores the matrix.
   void jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
                       double* const* out) override;
+  // Phi_q^T mu (F1) and Phi_q^T lambda (F2) of constraint k, and its rows of F3 = s Phi and
+  // F4 = s (Phi_q v + Phi_t) (rows[0], rows[1]).
+  bool gives_constraint_terms() const override { return true; }
+  void constraint_terms(double t, const double* y, int k, ConstraintTerms& out) const override;
 
   bool velocities_error_tested() const override { return v_in_test_; }
 

@@ -86,6 +86,16 @@ class MultibodyDae : public DaeProblem {
   // for all its uses and all x). The sensitivities' F_y s (formulation/twin_sensitivities.h).
   virtual void jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
                               double* const* out);
+  // Constraint k's own terms of the residual at (t, y): its rows of F1 and F2 on its two bodies'
+  // local coordinates [ri, pi, rj, pj] and its own rows of the formulation's constraint blocks
+  // (up to 3 each), for F_p over the constraints a parameter reaches (formulation/parameter_reach.h).
+  // Only where gives_constraint_terms() (elsewhere F_p takes whole residuals).
+  struct ConstraintTerms {
+    Vec14 f1, f2;
+    double rows[2][3];
+  };
+  virtual bool gives_constraint_terms() const { return false; }
+  virtual void constraint_terms(double /*t*/, const double* /*y*/, int /*k*/, ConstraintTerms& /*out*/) const {}
   // Output state from an interpolated (y, y'): optionally projected onto the constraint
   // manifold (positions and velocities), then the accelerations solved from it. Returns the
   // position violation of the interpolated y. (Same contract as Index3Dae::consistent_output.)
@@ -106,6 +116,7 @@ class MultibodyDae : public DaeProblem {
   int nq() const { return nq_; }
   int nc() const { return nc_; }
   const System& system() const { return sys_; }
+  int constraint_offset(int k) const { return offsets_[k]; }
   AugmentedSolver& augmented() { return aug_; }
 
  protected:

@@ -15,10 +15,13 @@ bool same(const CoordinateFunction& a, const CoordinateFunction& b) {
          a.anchor == b.anchor && a.origin == b.origin;
 }
 
+bool same_structure(const Constraint& a, const Constraint& b) {
+  return a.type == b.type && a.owner == b.owner && a.bi == b.bi && a.bj == b.bj && a.mask == b.mask;
+}
+
 bool same(const Constraint& a, const Constraint& b) {
-  return a.type == b.type && a.owner == b.owner && a.bi == b.bi && a.bj == b.bj && a.si == b.si && a.sj == b.sj &&
-         a.ai == b.ai && a.aj == b.aj && a.distance == b.distance && a.w == b.w && same(a.coord, b.coord) &&
-         same(a.target, b.target) && a.mask == b.mask;
+  return same_structure(a, b) && a.si == b.si && a.sj == b.sj && a.ai == b.ai && a.aj == b.aj &&
+         a.distance == b.distance && a.w == b.w && same(a.coord, b.coord) && same(a.target, b.target);
 }
 
 // A force whose law reads only the numbers compared below.
@@ -50,8 +53,11 @@ ParameterReach parameter_reach(const System& run, const System& plus, const Syst
   for (const System* twin : {&plus, &minus}) {
     if (!same_size(run, *twin)) return r;
     for (size_t k = 0; k < run.constraints.size(); ++k)
-      if (!same(run.constraints[k], twin->constraints[k])) return r;
+      if (!same_structure(run.constraints[k], twin->constraints[k])) return r;
   }
+  for (size_t k = 0; k < run.constraints.size(); ++k)
+    if (!same(run.constraints[k], plus.constraints[k]) || !same(run.constraints[k], minus.constraints[k]))
+      r.constraints.push_back(static_cast<int>(k));
   const bool gravity = run.gravity != plus.gravity || run.gravity != minus.gravity;  // every body's weight
   for (size_t b = 0; b < run.bodies.size(); ++b)
     for (const System* twin : {&plus, &minus})

@@ -11,11 +11,15 @@ namespace mbdae {
 
 struct ParameterReach {
   // True when the twins differ from the run's model only in the listed bodies' mass and inertia
-  // (all bodies when gravity differs) and the listed forces: F_p is then their rows of M v' - Q
-  // alone. False: anything else (a constraint, a point, the model's size) may differ, and F_p
-  // takes the twins' whole residuals.
+  // (all bodies when gravity differs), the listed forces and the listed constraints' numbers:
+  // F_p is then their terms alone. False: the model's structure differs, and F_p takes the
+  // twins' whole residuals.
   bool local = false;
   std::vector<int> bodies, forces;
+  // Constraints whose numbers differ (their points, axes, distances, drives), the structure
+  // (type, bodies, rows) the same: their own terms, where the formulation gives them
+  // (MultibodyDae::constraint_terms), else F_p takes the whole residuals.
+  std::vector<int> constraints;
 };
 
 // Forces whose law reads more than their own numbers (expressions, user laws, sensors, a joint

@@ -20,6 +20,7 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
     if (!p.plus || !p.minus || p.plus->size() != n || p.minus->size() != n || !(p.delta > 0))
       throw std::invalid_argument("TwinSensitivities: twins of another size than the run's DAE");
     p.reach = parameter_reach(run_.system(), p.plus->system(), p.minus->system());
+    if (!p.reach.constraints.empty() && !base_->gives_constraint_terms()) p.reach.local = false;
     p.breakpoints_plus = p.plus->breakpoints();
     p.breakpoints_minus = p.minus->breakpoints();
     if (p.breakpoints_plus.size() != breakpoints_.size() || p.breakpoints_minus.size() != breakpoints_.size())
@@ -103,7 +104,8 @@ int TwinSensitivities::add_parameter_difference(double t, const double* y, const
 }
 
 // The same difference over the terms p reaches: the listed bodies' rows of M v' - Q (weight,
-// gyroscopic) and the listed forces' -Q, each twin's at the run's (y, y').
+// gyroscopic), the listed forces' -Q and the listed constraints' own terms, each twin's at the
+// run's (y, y').
 int TwinSensitivities::add_reached_difference(double t, const double* y, const double* yp, ParameterTwins& p,
                                               double* r) {
   const int nq = run_.nq();
@@ -119,6 +121,22 @@ int TwinSensitivities::add_reached_difference(double t, const double* y, const d
     body_momentum(sm, b, y, v, yp + nq, om);
     for (int k = 0; k < 7; ++k) f2[7 * b + k] += (op[k] - om[k]) * f;
   }
+  const int nc = run_.system().num_constraint_rows();
+  for (int k : p.reach.constraints) {
+    MultibodyDae::ConstraintTerms cp, cm;
+    p.plus->constraint_terms(t, y, k, cp);
+    p.minus->constraint_terms(t, y, k, cm);
+    const Constraint& c = sp.constraints[k];
+    for (int l = 0; l < 14; ++l) {
+      const int g = global_index(c.bi, c.bj, l);
+      if (g < 0) continue;
+      r[g] += (cp.f1[l] - cm.f1[l]) * f;
+      f2[g] += (cp.f2[l] - cm.f2[l]) * f;
+    }
+    const int o = run_.constraint_offset(k);
+    for (int b = 0; b < 2; ++b)
+      for (int row = 0; row < c.rows(); ++row) r[2 * nq + b * nc + o + row] += (cp.rows[b][row] - cm.rows[b][row]) * f;
+  }
   const double tp = p.plus->input_time(t), tm = p.minus->input_time(t);
   for (int k : p.reach.forces) {
     const Vec14 qp = force_local(sp, k, p.plus->state().modes, y, v, tp, &p.plus->state().turns);
@@ -129,8 +147,8 @@ int TwinSensitivities::add_reached_difference(double t, const double* y, const d
       if (g >= 0) f2[g] -= (qp[l] - qm[l]) * f;
     }
   }
-  for (int i = 0; i < nq; ++i)
-    if (!std::isfinite(f2[i])) return 1;  // recoverable, as a twin's non-finite residual
+  for (int i = 0; i < run_.size(); ++i)
+    if (!std::isfinite(r[i])) return 1;  // recoverable, as a twin's non-finite residual
   return 0;
 }
 

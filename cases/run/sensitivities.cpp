@@ -12,6 +12,7 @@
 #include "cases/scene/field_ranges.h"  // parse_number
 #include "core/errors.h"
 #include "core/finite_check.h"
+#include "formulation/constraints.h"  // constraint_group
 #include "formulation/mechanics.h"  // initial_modes
 #include "formulation/model_rules.h"  // did_you_mean
 #include "formulation/parameter_reach.h"
@@ -450,13 +451,19 @@ NormalizedSensitivities normalized_sensitivities(const Result& r) {
 // How F_p is formed for p (formulation/parameter_reach.h), for summary.json.
 std::string reach_text(const System& sys, const SensitivityParameter& p) {
   const ParameterReach r = parameter_reach(sys, *p.twin[0]->context->system, *p.twin[1]->context->system);
-  if (!r.local) return "the twins' whole residuals (the parameter reaches a constraint or a point)";
+  if (!r.local) return "the twins' whole residuals (the parameter changes the model's structure)";
   std::string out = "the terms it may reach:";
   for (int b : r.bodies) out += " body " + sys.bodies[b].name + ",";
   for (int k : r.forces) out += " force " + sys.forces[k].name + ",";
-  if (r.bodies.empty() && r.forces.empty()) return "zero (the parameter reaches no term of the dynamics' residual)";
-  out.back() = ' ';
+  std::vector<std::string> groups;  // a joint's or cut's several constraints named once
+  for (int k : r.constraints)
+    if (std::find(groups.begin(), groups.end(), constraint_group(sys.constraints[k])) == groups.end())
+      groups.push_back(constraint_group(sys.constraints[k]));
+  for (const std::string& g : groups) out += " " + g + ",";
+  if (r.bodies.empty() && r.forces.empty() && r.constraints.empty())
+    return "zero (the parameter reaches no term of the dynamics' residual)";
   out.pop_back();
+  if (!r.constraints.empty()) out += " (its constraints' terms with index2-ggl; index1 and penalty take the twins' whole residuals)";
   return out;
 }
 

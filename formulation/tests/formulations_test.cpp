@@ -170,8 +170,9 @@ TEST(Formulations, JacobianTimesIsTheAssembledMatrixAtCjZeroTimesX) {
 
 // F_p over the terms a parameter reaches (formulation/parameter_reach.h) against the twins' whole
 // residuals: the sensitivity residual at s = s' = 0 is F_p. Force numbers (a spring's, a user
-// law's, the tyre's), a mass, an inertia and gravity reach bodies and forces only; a centre of
-// mass moves the constraints' points and takes the whole residuals.
+// law's, the tyre's), a mass, an inertia and gravity reach bodies and forces; a centre of mass,
+// a cut's length and a drive's amplitude reach constraints' terms (GglDae gives them; index1
+// does not, and takes the whole residuals).
 TEST(Formulations, ReachedParameterDifferenceIsTheWholeResidualsDifference) {
   const Model base = testing::all_types_model();
   const System sys = build_system(base);
@@ -187,7 +188,9 @@ TEST(Formulations, ReachedParameterDifferenceIsTheWholeResidualsDifference) {
       {"mass of a", [](Model& m, double d) { m.bodies[0].mass += d; }, true},
       {"inertia of b", [](Model& m, double d) { m.bodies[1].inertia(0, 0) += d; }, true},
       {"gravity z", [](Model& m, double d) { m.gravity[2] += d; }, true},
-      {"centre of mass of b", [](Model& m, double d) { m.bodies[1].com[0] += d; }, false}};
+      {"centre of mass of b", [](Model& m, double d) { m.bodies[1].com[0] += d; }, true},
+      {"distance cut's length", [](Model& m, double d) { m.cuts[5].distance += d; }, true},
+      {"drive's amplitude", [](Model& m, double d) { m.coordinates["qf2"].drive.a += d; }, true}};
   std::vector<double> y, yp;
   testing::dae_vectors(random_state(sys, 9), 2 * sys.nq() + 2 * sys.num_constraint_rows(), true, y, yp);
   for (const Case& c : cases) {
@@ -229,6 +232,21 @@ TEST(Formulations, ReachedParameterDifferenceIsTheWholeResidualsDifference) {
     EXPECT_GT(largest, 1e-2) << c.what;
     EXPECT_LT(worst, 1e-8 * largest) << c.what;
   }
+  // index1 gives no constraint terms: a centre of mass takes the whole residuals there.
+  std::vector<std::unique_ptr<System>> systems;
+  std::vector<ParameterTwins> twins(1);
+  for (int side = 0; side < 2; ++side) {
+    Model m = base;
+    m.bodies[1].com[0] += side == 0 ? 1e-4 : -1e-4;
+    systems.push_back(std::make_unique<System>(build_system(m)));
+    (side == 0 ? twins[0].plus : twins[0].minus) =
+        std::make_unique<Index1Dae>(*systems.back(), 5.0, BaumgarteParameters{10.0, 20.0});
+  }
+  twins[0].delta = 1e-4;
+  Index1Dae i1(sys, 5.0, BaumgarteParameters{10.0, 20.0});
+  const TwinSensitivities ts(i1, std::make_unique<Index1Dae>(sys, 5.0, BaumgarteParameters{10.0, 20.0}),
+                             std::move(twins), true);
+  EXPECT_FALSE(ts.twins(0).reach.local);
 }
 
 TEST(Formulations, Index1NewtonMatrixExactBlocksAndOmittedGammaQ) {
