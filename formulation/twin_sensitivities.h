@@ -17,10 +17,10 @@
 // twins along s, [F+(y + d s, y') - F-(y - d s, y')] / (2 d), with A0 only after its failures:
 // its truncation, d^2 times the third derivative along (s, 1), put A05's sensitivities 1.8e-1
 // off (docs/sensitivities.md, Method).
-// F_p takes two whole residuals of the twins only where the parameter reaches more than bodies'
-// inertia and forces (formulation/parameter_reach.h: a constraint, a point); a force's stiffness,
-// a body's mass or gravity difference just those terms, the same central difference without the
-// cancelling rest.
+// F_p takes two whole residuals of the twins only where the parameter changes the model's
+// structure, or reaches a constraint and the formulation gives no constraint terms
+// (formulation/parameter_reach.h); a force's stiffness, a body's mass, gravity or a hardpoint
+// difference just the terms they reach, the same central difference without the cancelling rest.
 // Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
 // differences of the twins' own consistent values and sensors at y +- d s.
 // A parameter that moves a breakpoint t_b (the time of an input's jump: a ground step, a point
