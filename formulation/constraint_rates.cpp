@@ -25,15 +25,14 @@ inline bool in_pattern(const Constraint& c, int l) {
   return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || constraint_hessian_touches_r(c));
 }
 
-// Phi_q v + Phi_t of one constraint, its Jacobian rows given.
+}  // namespace
+
 void velocity_rows(const Constraint& c, const Row14* rows, const double* v, double t, double* out) {
   double pt[3], ptt[3];
   constraint_time_derivatives(c, t, pt, ptt);
   const Vec14 vl = gather_local(v, c.bi, c.bj);
   for (int r = 0; r < c.rows(); ++r) out[r] = rows[r].dot(vl) + pt[r];
 }
-
-}  // namespace
 
 void velocity_constraint_values(const System& sys, const std::vector<int>& off, const double* q,
                                 const double* v, double t, double* out) {

@@ -22,6 +22,8 @@ namespace mbdae {
 
 // H_r = d2(Phi_r)/dq2 (local 14 x 14) of each of constraint c's rows r at s.
 void row_hessians(const Constraint& c, const LocalState& s, Mat14* h);
+// Phi_q v + Phi_t of constraint c's rows, its Jacobian rows given (v global).
+void velocity_rows(const Constraint& c, const Row14* rows, const double* v, double t, double* out);
 
 // Phi_q v + Phi_t (the velocity-level constraints).
 void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,

@@ -197,11 +197,10 @@ void GglDae::constraint_terms(double t_in, const double* y, int k, ConstraintTer
   const Constraint& c = sys_.constraints[k];
   const LocalState s = gather(y, c.bi, c.bj);
   Row14 rows[3];
-  double phi[3], phi_t[3], phi_tt[3];
+  double phi[3], rates[3];
   constraint_jacobian(c, s, rows);
   constraint_value(c, s, t, phi);
-  constraint_time_derivatives(c, t, phi_t, phi_tt);
-  const Vec14 vl = gather_local(y + nq_, c.bi, c.bj);
+  velocity_rows(c, rows, y + nq_, t, rates);
   const double* lambda = y + 2 * nq_ + offsets_[k];
   const double* mu = y + 2 * nq_ + nc_ + offsets_[k];
   out.f1.setZero();
@@ -210,7 +209,7 @@ void GglDae::constraint_terms(double t_in, const double* y, int k, ConstraintTer
     out.f1 += mu[r] * rows[r].transpose();
     out.f2 += lambda[r] * rows[r].transpose();
     out.rows[0][r] = scale_ * phi[r];
-    out.rows[1][r] = scale_ * (rows[r].dot(vl) + phi_t[r]);
+    out.rows[1][r] = scale_ * rates[r];
   }
 }
 

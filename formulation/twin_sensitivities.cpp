@@ -52,10 +52,10 @@ int TwinSensitivities::run_breakpoint(double t) const {
 // run's step, before the twin's).
 void TwinSensitivities::set_segment(double t_start, double t_end) {
   base_->set_segment(t_start, t_end);
-  const int ke = run_breakpoint(t_end);
-  int passed = -1;  // the last of the run's breakpoints at or before t_start
+  const int ke = run_breakpoint(t_end), ks = run_breakpoint(t_start);
+  int passed = ks;  // the last of the run's breakpoints at or before t_start
   for (size_t k = 0; k < breakpoints_.size(); ++k)
-    if (breakpoints_[k] <= t_start || static_cast<int>(k) == run_breakpoint(t_start)) passed = static_cast<int>(k);
+    if (breakpoints_[k] <= t_start) passed = std::max(passed, static_cast<int>(k));
   for (ParameterTwins& p : twins_)
     for (int side = 0; side < 2; ++side) {
       MultibodyDae& twin = side == 0 ? *p.plus : *p.minus;

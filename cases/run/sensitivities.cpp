@@ -84,39 +84,37 @@ std::unique_ptr<TwinRun> make_twin(const RunContext& c, const SensitivityParamet
 // end, and any other input that varies with time (each twin holds its inputs over the d between
 // its breakpoint and the run's, which is exact for steps only).
 bool moves_inside_integrated_step(const RunContext& c, double b) {
-  for (const AnalysisStep& step : c.scene.steps) {
-    const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
-    if (integrated && b > step.t0 && b < step.t_end) return true;
-  }
+  for (const AnalysisStep& step : c.scene.steps)
+    if (integrates(step) && b > step.t0 && b < step.t_end) return true;
   return false;
 }
 
 std::string step_span(const AnalysisStep& step) {
-  const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
-  return integrated ? "t = " + short_text(step.t0) + " to " + short_text(step.t_end) : "at t = " + short_text(step.t0);
+  return integrates(step) ? "t = " + short_text(step.t0) + " to " + short_text(step.t_end) : "at t = " + short_text(step.t0);
 }
 
 // The analysis step whose start or end (a static step's time: its t0) lies between the run's
 // breakpoint b and a twin's bt, or at either: there the run's start or end sees one side of the
 // input's jump and the twin the other, which has no derivative. Null if none.
 const AnalysisStep* crossed_step(const RunContext& c, double b, double bt) {
-  for (const AnalysisStep& step : c.scene.steps) {
-    const bool integrated = step.type == AnalysisStep::Type::kDynamics || step.type == AnalysisStep::Type::kKinematics;
+  for (const AnalysisStep& step : c.scene.steps)
     for (const double x : {step.t0, step.t_end})
-      if ((integrated || x == step.t0) && (b - x) * (bt - x) <= 0) return &step;
-  }
+      if ((integrates(step) || x == step.t0) && (b - x) * (bt - x) <= 0) return &step;
   return nullptr;
 }
 
-std::string breakpoint_refusal(const System& sys, const System& twin) {
-  std::vector<double> drives, twin_drives;
+std::vector<double> drive_breakpoints(const System& sys) {
+  std::vector<double> t;
   for (const Constraint& k : sys.constraints)
     if (k.type == Constraint::Type::kCoordinate)
-      for (double b : k.target.breakpoints()) drives.push_back(b);
-  for (const Constraint& k : twin.constraints)
-    if (k.type == Constraint::Type::kCoordinate)
-      for (double b : k.target.breakpoints()) twin_drives.push_back(b);
-  if (drives != twin_drives) return "a driven coordinate's breakpoint";
+      for (double b : k.target.breakpoints()) t.push_back(b);
+  return t;
+}
+
+// Why a moved breakpoint's jump is not covered ("" where it is). check_breakpoints has refused
+// breakpoints that appear, vanish or merge before.
+std::string breakpoint_refusal(const System& sys, const System& twin) {
+  if (drive_breakpoints(sys) != drive_breakpoints(twin)) return "a driven coordinate's breakpoint";
   for (const Force& f : sys.forces) {
     for (const TimeFunction* g : {&f.fx, &f.fy, &f.fz, &f.ground})
       if (g->kind != TimeFunction::Kind::kConstant && g->kind != TimeFunction::Kind::kStep)
@@ -130,7 +128,6 @@ std::string breakpoint_refusal(const System& sys, const System& twin) {
       return "a model with the user law '" + f.name + "' (" + f.law->name + "), which may read t, and the twins "
              "cannot hold it over their step";
   }
-  if (sys.breakpoints().size() != twin.breakpoints().size()) return "breakpoints that appear, vanish or merge";
   return "";
 }
 
@@ -144,9 +141,10 @@ double nearest(const std::vector<double>& ts, double t) {
 void check_breakpoints(const RunContext& c, SensitivityParameter& p) {
   const std::vector<double> own = c.system->breakpoints();
   auto same_time = [](double a, double b) { return std::fabs(a - b) <= 4 * 2.220446049250313e-16 * std::max(std::fabs(a), std::fabs(b)); };
+  const std::vector<double> minus = p.twin[1]->context->system->breakpoints();  // for dt/dp
   for (int side = 0; side < 2; ++side) {
     const System& twin_sys = *p.twin[side]->context->system;
-    const std::vector<double> twin = twin_sys.breakpoints();
+    const std::vector<double> twin = side == 0 ? twin_sys.breakpoints() : minus;
     auto refuse = [&](double b, double bt, const std::string& what) {
       throw ModelError(c.scene.file, 0, "sensitivities",
                        "'" + p.path + "' moves the breakpoint at t = " + short_text(b) + " (" +
@@ -184,7 +182,7 @@ void check_breakpoints(const RunContext& c, SensitivityParameter& p) {
       if (side == 0)
         p.moved_breakpoints.push_back(
             {{"t", b},
-             {"dt_dp", (bt - p.twin[1]->context->system->breakpoints()[k]) / (2 * p.delta)},
+             {"dt_dp", (bt - minus[k]) / (2 * p.delta)},
              {"note", "the sensitivities jump there by (y'- - y'+) dt/dp on q and v (docs/sensitivities.md)"}});
     }
   }
