@@ -435,6 +435,61 @@ bool constraint_hessian_touches_r(const Constraint& c) {
   return primitive(c).hessian_touches_r || (c.type == Constraint::Type::kCoordinate && !c.coord.rotation);
 }
 
+// The closed forms: A(p) s is quadratic in the Euler parameters and B(p, s) = d(A(p) s)/dp
+// linear, so K(s, w) x = B(x, s)^T w (formulation/euler_parameters.h).
+bool constraint_hessian_products(const Constraint& c, const LocalState& s, const Vec14& x, const Vec14& v,
+                                 const double* mu, const double* lambda, Vec14& f1, Vec14& f2, double* g) {
+  switch (c.type) {
+    case Constraint::Type::kPoint: {  // r_i + A_i s_i - r_j - A_j s_j: H_r x on p_i is row r of B(x_pi, s_i)
+      Vec3 m3 = Vec3::Zero(), l3 = Vec3::Zero(), gv = Vec3::Zero();
+      for (int k = 0, r = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) {
+          m3[k] = mu[r];
+          l3[k] = lambda[r++];
+        }
+      for (int side = 0; side < 2; ++side) {
+        const int b = side == 0 ? c.bi : c.bj, o = side == 0 ? kPi4 : kPj;
+        if (b < 0) continue;
+        const double sign = side == 0 ? 1.0 : -1.0;
+        const Mat34 bx = B_matrix(x.segment<4>(o), side == 0 ? c.si : c.sj);
+        f1.segment<4>(o) += sign * (bx.transpose() * m3);
+        f2.segment<4>(o) += sign * (bx.transpose() * l3);
+        gv += sign * (bx * v.segment<4>(o));
+      }
+      for (int k = 0, r = 0; k < 3; ++k)
+        if (c.mask & (1 << k)) g[r++] = gv[k];
+      return true;
+    }
+    case Constraint::Type::kDot1: {  // u.w, u = A_i a_i, w = A_j a_j: H x on p_i is B(p_i, a_i)^T B(p_j, a_j) x_pj + B(x_pi, a_i)^T w
+      const Vec3 u = world_vector(c.bi, s.pi, c.ai), w = world_vector(c.bj, s.pj, c.aj);
+      Mat34 bi = Mat34::Zero(), bj = Mat34::Zero();
+      Vec3 du = Vec3::Zero(), dw = Vec3::Zero();  // u and w along x
+      if (c.bi >= 0) {
+        bi = B_matrix(s.pi, c.ai);
+        du = bi * x.segment<4>(kPi4);
+      }
+      if (c.bj >= 0) {
+        bj = B_matrix(s.pj, c.aj);
+        dw = bj * x.segment<4>(kPj);
+      }
+      Vec14 hx = Vec14::Zero();
+      if (c.bi >= 0) hx.segment<4>(kPi4) = bi.transpose() * dw + B_matrix(x.segment<4>(kPi4), c.ai).transpose() * w;
+      if (c.bj >= 0) hx.segment<4>(kPj) = bj.transpose() * du + B_matrix(x.segment<4>(kPj), c.aj).transpose() * u;
+      f1 += mu[0] * hx;
+      f2 += lambda[0] * hx;
+      g[0] = v.dot(hx);
+      return true;
+    }
+    case Constraint::Type::kNorm:  // p_i.p_i - 1: H = 2 I on p_i
+      f1.segment<4>(kPi4) += (2.0 * mu[0]) * x.segment<4>(kPi4);
+      f2.segment<4>(kPi4) += (2.0 * lambda[0]) * x.segment<4>(kPi4);
+      g[0] = 2.0 * v.segment<4>(kPi4).dot(x.segment<4>(kPi4));
+      return true;
+    default:
+      return false;
+  }
+}
+
 void orientation_rows(const Vec4& c_i, const Vec4& c_j, Vec4 w[3]) {
   const Vec4 cj_conj(c_j[0], -c_j[1], -c_j[2], -c_j[3]);
   const Vec4 d = quaternion_product(c_i, cj_conj);

@@ -85,6 +85,11 @@ void constraint_gamma(const Constraint& c, const LocalState& s, const LocalState
 // Whether the Hessian has entries in the position (r) rows and columns (dot-2, distance,
 // translation coordinates); the others depend on r linearly or not at all.
 bool constraint_hessian_touches_r(const Constraint& c);
+// The Hessian terms of the constraint's rows along one direction x (local, like v), without the
+// Hessians, where its type has them in closed form (point, dot-1, norm): f1 += sum_r mu_r H_r x,
+// f2 += sum_r lambda_r H_r x, g[r] = v^T H_r x. False, nothing added, for the other types.
+bool constraint_hessian_products(const Constraint& c, const LocalState& s, const Vec14& x, const Vec14& v,
+                                 const double* mu, const double* lambda, Vec14& f1, Vec14& f2, double* g);
 // Global index of local coordinate l (0..13) of a constraint between bodies bi, bj; -1 for ground.
 inline int global_index(int bi, int bj, int l) {
   const int b = l < 7 ? bi : bj;

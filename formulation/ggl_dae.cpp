@@ -4,7 +4,6 @@
 
 #include "formulation/constraint_rates.h"
 #include "formulation/constraints.h"
-#include "formulation/euler_parameters.h"
 #include "formulation/mechanics.h"
 
 namespace mbdae {
@@ -77,62 +76,6 @@ void hessian_terms(const Constraint& c, const Mat14* h, const Vec14& x, const Ve
   }
 }
 
-// The same for a point constraint (r_i + A_i s_i - r_j - A_j s_j) without its Hessians: A(p) s is
-// quadratic in p and B(p, s) = d(A(p) s)/dp linear, so H_r x on p_i is row r of B(x_pi, s_i)
-// (K(s, w) x = B(x, s)^T w, formulation/euler_parameters.h), and on p_j minus that of B(x_pj, s_j).
-void point_hessian_terms(const Constraint& c, const Vec14& x, const Vec14& vl, const double* mu, const double* lambda,
-                         Vec14& f1, Vec14& f2, double* g) {
-  constexpr int kPi = 3, kPj = 10;
-  Vec3 m3 = Vec3::Zero(), l3 = Vec3::Zero(), gv = Vec3::Zero();
-  for (int k = 0, r = 0; k < 3; ++k)
-    if (c.mask & (1 << k)) {
-      m3[k] = mu[r];
-      l3[k] = lambda[r++];
-    }
-  for (int side = 0; side < 2; ++side) {
-    const int b = side == 0 ? c.bi : c.bj, o = side == 0 ? kPi : kPj;
-    if (b < 0) continue;
-    const double sign = side == 0 ? 1.0 : -1.0;
-    const Mat34 bx = B_matrix(x.segment<4>(o), side == 0 ? c.si : c.sj);
-    f1.segment<4>(o) += sign * (bx.transpose() * m3);
-    f2.segment<4>(o) += sign * (bx.transpose() * l3);
-    gv += sign * (bx * vl.segment<4>(o));
-  }
-  for (int k = 0, r = 0; k < 3; ++k)
-    if (c.mask & (1 << k)) g[r++] = gv[k];
-}
-
-// Dot-1, u.w with u = A_i a_i and w = A_j a_j (each quadratic in its p, B linear): H x on p_i is
-// B(p_i, a_i)^T B(p_j, a_j) x_pj + B(x_pi, a_i)^T w, on p_j the same with i and j swapped.
-void dot1_hessian_terms(const Constraint& c, const LocalState& s, const Vec14& x, const Vec14& vl, double mu,
-                        double lambda, Vec14& f1, Vec14& f2, double* g) {
-  constexpr int kPi = 3, kPj = 10;
-  const Vec3 u = c.bi < 0 ? c.ai : rotate(s.pi, c.ai), w = c.bj < 0 ? c.aj : rotate(s.pj, c.aj);
-  Mat34 bi = Mat34::Zero(), bj = Mat34::Zero();
-  Vec3 du = Vec3::Zero(), dw = Vec3::Zero();  // u and w along x
-  if (c.bi >= 0) {
-    bi = B_matrix(s.pi, c.ai);
-    du = bi * x.segment<4>(kPi);
-  }
-  if (c.bj >= 0) {
-    bj = B_matrix(s.pj, c.aj);
-    dw = bj * x.segment<4>(kPj);
-  }
-  Vec14 hx = Vec14::Zero();
-  if (c.bi >= 0) hx.segment<4>(kPi) = bi.transpose() * dw + B_matrix(x.segment<4>(kPi), c.ai).transpose() * w;
-  if (c.bj >= 0) hx.segment<4>(kPj) = bj.transpose() * du + B_matrix(x.segment<4>(kPj), c.aj).transpose() * u;
-  f1 += mu * hx;
-  f2 += lambda * hx;
-  g[0] = vl.dot(hx);
-}
-
-// Norm, p_i.p_i - 1: H = 2 I on p_i.
-void norm_hessian_terms(const Vec14& x, const Vec14& vl, double mu, double lambda, Vec14& f1, Vec14& f2, double* g) {
-  constexpr int kPi = 3;
-  f1.segment<4>(kPi) += (2.0 * mu) * x.segment<4>(kPi);
-  f2.segment<4>(kPi) += (2.0 * lambda) * x.segment<4>(kPi);
-  g[0] = 2.0 * vl.segment<4>(kPi).dot(x.segment<4>(kPi));
-}
 }  // namespace
 
 void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int count, const double* const* x,
@@ -155,10 +98,7 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
     const Constraint& c = sys_.constraints[k];
     const LocalState s = gather(q, c.bi, c.bj);
     constraint_jacobian(c, s, rows);
-    const Constraint::Type type = c.type;
-    const bool own = type == Constraint::Type::kPoint || type == Constraint::Type::kDot1 ||
-                     type == Constraint::Type::kNorm;  // Hessian terms without the Hessians
-    if (!own) row_hessians(c, s, h);
+    bool have_h = false;  // the row Hessians, computed once where the type has no closed form
     const Vec14 vl = gather_local(v, c.bi, c.bj);
     const int o = offsets_[k];
     for (int i = 0; i < count; ++i) {
@@ -167,14 +107,11 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
       const Vec14 xq = gather_local(xi, c.bi, c.bj), xv = gather_local(xi + nq_, c.bi, c.bj);
       Vec14 f1 = Vec14::Zero(), f2 = Vec14::Zero();
       double g[3];
-      if (type == Constraint::Type::kPoint)
-        point_hessian_terms(c, xq, vl, mu + o, lambda + o, f1, f2, g);
-      else if (type == Constraint::Type::kDot1)
-        dot1_hessian_terms(c, s, xq, vl, mu[o], lambda[o], f1, f2, g);
-      else if (type == Constraint::Type::kNorm)
-        norm_hessian_terms(xq, vl, mu[o], lambda[o], f1, f2, g);
-      else
+      if (!constraint_hessian_products(c, s, xq, vl, mu + o, lambda + o, f1, f2, g)) {
+        if (!have_h) row_hessians(c, s, h);
+        have_h = true;
         hessian_terms(c, h, xq, vl, mu + o, lambda + o, f1, f2, g);
+      }
       for (int r = 0; r < c.rows(); ++r) {
         const int row = o + r;
         f1 += xi[2 * nq_ + nc_ + row] * rows[r].transpose();           // Phi_q^T x_mu
