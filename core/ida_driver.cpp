@@ -195,6 +195,7 @@ void open_run(IdaRun& r, const std::vector<double>& y0, const std::vector<double
   r.mem = check(IDACreate(r.ctx), "IDACreate");
   r.ud.problem = r.problem;
   r.ud.mem = r.mem;
+  r.ud.ls = r.ls;
   r.ud.rtol = o.rtol;
   r.ud.atol = o.atol;
   r.ud.h_initial = o.initial_step > 0 ? o.initial_step : 1e-6 * (o.t1 - o.t0);

@@ -21,6 +21,7 @@ namespace mbdae::ida_detail {
 struct UserData {
   DaeProblem* problem;
   void* mem;
+  SUNLinearSolver ls = nullptr;  // the Newton matrix's solver (the sensitivities' solves batched)
   double rtol, atol, h_initial;
   std::string last_ida_error;  // IDA's own words about its last error (not printed)
   std::string callback_error;  // an exception of the problem's residual or Jacobian

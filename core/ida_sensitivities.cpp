@@ -9,6 +9,7 @@
 
 #include "core/finite_check.h"
 #include "core/ida_run.h"
+#include "core/klu_linear_solver.h"
 
 namespace mbdae::ida_detail {
 namespace {
@@ -24,8 +25,11 @@ int sensitivity_residual_fn(int ns, sunrealtype t, N_Vector y, N_Vector yp, N_Ve
     u->r_out[i] = N_VGetArrayPointer(rs[i]);
   }
   try {
-    return u->sens->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r), u->s_in.data(),
-                             u->sp_in.data(), u->r_out.data());
+    const int flag = u->sens->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r),
+                                       u->s_in.data(), u->sp_in.data(), u->r_out.data());
+    // IDAS solves these right-hand sides next, one after the other: together, in one pass.
+    klu_linear_solver_expect_batch(u->ls, u->r_out.data(), flag == 0 ? ns : 0);
+    return flag;
   } catch (const SolveError& e) {
     return callback_solve_error(u, e);
   } catch (const std::exception& e) {

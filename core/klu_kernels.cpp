@@ -77,6 +77,93 @@ void klu_solve_one(const klu_symbolic& S, const klu_numeric& N, double* b) {
 
 namespace {
 
+// The same for NR right-hand sides interleaved in X (X[NR k + r], as klu_solve keeps them): each
+// factor entry's row and value are read once for all of them, the NR updates in pairs (GCC's
+// vector extension: the same IEEE operations per entry as the scalar loop, so bit for bit).
+typedef double Pair __attribute__((vector_size(16)));
+
+inline Pair load_pair(const double* p) {
+  Pair v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store_pair(double* p, Pair v) { __builtin_memcpy(p, &v, sizeof v); }
+
+template <int NR>
+inline void subtract_column_many(double* __restrict X, const PackedColumn& c, const double* x) {
+  const int* __restrict rows = c.rows;
+  const double* __restrict values = c.values;
+  const Pair x01 = {x[0], x[1]};
+  const Pair x23 = {NR > 2 ? x[2] : 0.0, NR > 3 ? x[3] : 0.0};
+  for (int p = 0; p < c.size; ++p) {
+    double* xr = X + NR * rows[p];
+    const double v = values[p];
+    const Pair vv = {v, v};
+    store_pair(xr, load_pair(xr) - vv * x01);
+    if constexpr (NR == 4) store_pair(xr + 2, load_pair(xr + 2) - vv * x23);
+    if constexpr (NR == 3) xr[2] -= v * x[2];
+  }
+}
+
+template <int NR>
+void solve_block_many(const klu_numeric& N, int block, int k1, int nk, double* X) {
+  double* lu = static_cast<double*>(N.LUbx[block]);
+  const double* udiag = static_cast<const double*>(N.Udiag) + k1;
+  for (int k = 0; k < nk; ++k) {
+    double x[NR];
+    for (int r = 0; r < NR; ++r) x[r] = X[NR * k + r];
+    subtract_column_many<NR>(X, column(lu, N.Lip + k1, N.Llen + k1, k), x);
+  }
+  for (int k = nk - 1; k >= 0; --k) {
+    double x[NR];
+    for (int r = 0; r < NR; ++r) x[r] = X[NR * k + r] = X[NR * k + r] / udiag[k];
+    subtract_column_many<NR>(X, column(lu, N.Uip + k1, N.Ulen + k1, k), x);
+  }
+}
+
+template <int NR>
+void solve_many(const klu_symbolic& S, const klu_numeric& N, double* const* b) {
+  const int n = S.n;
+  double* X = static_cast<double*>(N.Xwork);
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < NR; ++r) X[NR * k + r] = b[r][N.Pnum[k]];
+  if (const double* rs = N.Rs)
+    for (int k = 0; k < n; ++k)
+      for (int r = 0; r < NR; ++r) X[NR * k + r] /= rs[k];
+  const double* udiag = static_cast<const double*>(N.Udiag);
+  const double* off = static_cast<const double*>(N.Offx);
+  for (int block = S.nblocks - 1; block >= 0; --block) {
+    const int k1 = S.R[block], k2 = S.R[block + 1];
+    if (k2 - k1 == 1)
+      for (int r = 0; r < NR; ++r) X[NR * k1 + r] /= udiag[k1];
+    else
+      solve_block_many<NR>(N, block, k1, k2 - k1, X + NR * k1);
+    if (block == 0) break;
+    for (int k = k1; k < k2; ++k)
+      for (int p = N.Offp[k]; p < N.Offp[k + 1]; ++p)
+        for (int r = 0; r < NR; ++r) X[NR * N.Offi[p] + r] -= off[p] * X[NR * k + r];
+  }
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < NR; ++r) b[r][S.Q[k]] = X[NR * k + r];
+}
+
+}  // namespace
+
+void klu_solve_many(const klu_symbolic& S, const klu_numeric& N, double* const* b, int nrhs) {
+  for (int first = 0; first < nrhs;) {
+    const int chunk = nrhs - first >= 4 ? 4 : nrhs - first;
+    switch (chunk) {
+      case 4: solve_many<4>(S, N, b + first); break;
+      case 3: solve_many<3>(S, N, b + first); break;
+      case 2: solve_many<2>(S, N, b + first); break;
+      default: klu_solve_one(S, N, b[first]);
+    }
+    first += chunk;
+  }
+}
+
+namespace {
+
 // KLU_scale's row scale: the largest |a| (scale 2 and up) or the sum of |a| (scale 1) of each
 // row, 1 for an empty row; indexed by the original row.
 void row_scale(int n, const int* Ap, const int* Ai, const double* Ax, int scale, double* Rs) {

@@ -13,6 +13,9 @@ namespace mbdae {
 // Solves A x = b in place for the factorization (symbolic, numeric) of A; uses numeric's Xwork
 // as klu_solve does.
 void klu_solve_one(const klu_symbolic& symbolic, const klu_numeric& numeric, double* b);
+// The same for nrhs right-hand sides b[0..nrhs), up to four in one pass over L and U (klu_solve's
+// layout, numeric's Xwork holding 4 n entries): bit for bit klu_solve_one on each.
+void klu_solve_many(const klu_symbolic& symbolic, const klu_numeric& numeric, double* const* b, int nrhs);
 
 // klu_refactor of A (colptr, rowind, values: the analyzed pattern) into numeric, for common.scale
 // > 0, numeric's row scale present and common.halt_if_singular (KLU's defaults; else it calls

@@ -4,6 +4,7 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <cstring>
+#include <vector>
 
 #include "core/klu_solver.h"
 #include "core/sundials_compat.h"
@@ -11,9 +12,17 @@
 namespace mbdae {
 namespace {
 
+// The sensitivities' right-hand sides announced by klu_linear_solver_expect_batch: `next` is the
+// one IDAS's next solve should name; all were solved together at the first.
+struct Batch {
+  std::vector<double*> rhs;
+  size_t next = 0;
+};
+
 struct Content {
   KluSolver klu;
   int last_flag = 0;
+  Batch batch;
 };
 Content* content(SUNLinearSolver s) { return static_cast<Content*>(s->content); }
 
@@ -31,8 +40,18 @@ int setup(SUNLinearSolver s, SUNMatrix a) {
 int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   Content* c = content(s);
   const sunindextype n = N_VGetLength(b);
-  std::memcpy(N_VGetArrayPointer(x), N_VGetArrayPointer(b), n * sizeof(double));
-  const bool ok = c->klu.solve(N_VGetArrayPointer(x));
+  double* bd = N_VGetArrayPointer(b);
+  Batch& batch = c->batch;
+  bool ok = true;
+  if (batch.next < batch.rhs.size() && bd == batch.rhs[batch.next]) {
+    // One of the announced right-hand sides, in IDAS's order: the first solves them all.
+    if (batch.next++ == 0) ok = c->klu.solve_many(batch.rhs.data(), static_cast<int>(batch.rhs.size()));
+    std::memcpy(N_VGetArrayPointer(x), bd, n * sizeof(double));
+  } else {
+    batch.rhs.clear();  // any other solve ends the batch
+    std::memcpy(N_VGetArrayPointer(x), bd, n * sizeof(double));
+    ok = c->klu.solve(N_VGetArrayPointer(x));
+  }
   c->last_flag = ok ? 0 : 1;
   return ok ? kLinSolSuccess : kLinSolFailUnrecoverable;
 }
@@ -56,6 +75,13 @@ SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx
   auto* c = new Content;
   c->klu.analyze(pattern);  // symbolic analysis once per pattern
   return new_direct_linear_solver(ctx, setup, solve, c);
+}
+
+void klu_linear_solver_expect_batch(SUNLinearSolver s, double* const* rhs, int count) {
+  if (!s || s->ops->solve != solve) return;
+  Batch& batch = content(s)->batch;
+  batch.rhs.assign(rhs, rhs + (count > 1 ? count : 0));  // capacity kept: no allocation per step
+  batch.next = 0;
 }
 
 int klu_linear_solver_fresh_factorizations(SUNLinearSolver s) {

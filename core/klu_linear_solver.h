@@ -42,6 +42,14 @@ SUNLinearSolver new_direct_linear_solver(SUNContext ctx, decltype(DirectSolverOp
 
 // The matrix given to setup must be a CSC SUNSparseMatrix with `pattern`.
 SUNLinearSolver make_klu_linear_solver(const CscPattern& pattern, SUNContext ctx);
+// The right-hand sides rhs[0..count) that IDAS's staggered sensitivity corrector is about to
+// solve one after the other (idaNlsLSolveSensStg: the sensitivities' residuals of one Newton
+// iteration, negated in place, then a solve for each in order). The first of those solves solves
+// them all in one pass over the factors (klu_solve_many: the factors' indices and values read
+// once for up to four; bit for bit the single solves); the others then only copy. A solve of
+// any other vector, or out of that order, ends the batch and solves alone. No effect for count
+// < 2 or on another solver.
+void klu_linear_solver_expect_batch(SUNLinearSolver s, double* const* rhs, int count);
 // Factorization counts of a solver made by make_klu_linear_solver.
 int klu_linear_solver_fresh_factorizations(SUNLinearSolver s);
 

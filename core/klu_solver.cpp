@@ -100,6 +100,12 @@ bool KluSolver::solve(double* b) {
   return true;
 }
 
+bool KluSolver::solve_many(double* const* b, int count) {
+  if (!numeric_) return false;
+  klu_solve_many(*symbolic_, *numeric_, b, count);
+  return true;
+}
+
 double KluSolver::condest() {
   if (!numeric_) return INFINITY;
   klu_condest(pattern_.colptr.data(), values_.data(), symbolic_, numeric_, &common_);

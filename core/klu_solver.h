@@ -26,6 +26,8 @@ class KluSolver {
   bool factor(const double* values);
   // Solves A x = b in place.
   bool solve(double* b);
+  // Solves A x = b[r] in place for r < count, up to four in one pass over the factors.
+  bool solve_many(double* const* b, int count);
   // Whether a factorization is held (solve can be called).
   bool factored() const { return numeric_ != nullptr; }
   // Reciprocal condition estimate of the last factorization.

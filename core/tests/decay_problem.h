@@ -90,21 +90,31 @@ class DecayProblem : public DaeProblem {
 class DecayInitialValue : public SensitivityProblem {
  public:
   double fail_after = 1e300;
-  int count() const override { return 1; }
+  // copies > 1: the same sensitivity `copies` times, copy i scaled by 2^i (exact in binary, so
+  // copy i is 2^i copy 0 bit for bit: IDAS's solves of several sensitivities at once).
+  int copies = 1;
+  int count() const override { return copies; }
   double scale(int) const override { return 1.0; }
   int residual(double t, const double*, const double*, const double*, const double* const* s, const double* const* sp,
                double* const* r) override {
     if (t > fail_after) return -1;
-    r[0][0] = sp[0][0] + s[0][0];
-    r[0][1] = s[0][1] - 2 * s[0][0];
+    for (int i = 0; i < copies; ++i) {
+      r[i][0] = sp[i][0] + s[i][0];
+      r[i][1] = s[i][1] - 2 * s[i][0];
+    }
     return 0;
   }
   void initial(double, const double*, const double*, double* const* s, double* const* sp) override {
-    s[0][0] = 1, s[0][1] = 2, sp[0][0] = -1, sp[0][1] = -2;
+    for (int i = 0; i < copies; ++i) {
+      const double c = std::ldexp(1.0, i);
+      s[i][0] = c, s[i][1] = 2 * c, sp[i][0] = -c, sp[i][1] = -2 * c;
+    }
   }
   void restart(double, const double*, const double*, double* const* s, double* const* sp) override {
-    sp[0][0] = -s[0][0];
-    sp[0][1] = -2 * s[0][0];
+    for (int i = 0; i < copies; ++i) {
+      sp[i][0] = -s[i][0];
+      sp[i][1] = -2 * s[i][0];
+    }
   }
   bool in_error_test() const override { return true; }
 };

@@ -244,6 +244,36 @@ TEST(IdaDriverSensitivities, FollowTheClosedFormThroughABreakpoint) {
   EXPECT_TRUE(st.sensitivity_failure.empty());
 }
 
+// Three sensitivities: IDAS solves them one after the other, mbdae's linear solver all three in
+// one pass over the factors at the first (klu_linear_solver_expect_batch). Copy i is 2^i copy 0
+// bit for bit at every sample, and copy 0 the closed form.
+TEST(IdaDriverSensitivities, SeveralAreSolvedTogetherAndEachIsItsOwn) {
+  DecayProblem p;
+  p.step_input = true;
+  DecayInitialValue sens;
+  sens.copies = 3;
+  std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
+  IdaOptions o;
+  o.t1 = 2;
+  o.rtol = 1e-10;
+  o.atol = 1e-12;
+  o.output_step = 0.1;
+  o.sensitivities = &sens;
+  double worst = 0;
+  int rows = 0, unequal = 0;
+  o.sensitivity_output = [&](double t, const double*, const double*, const double* const* s, const double* const*) {
+    worst = std::max({worst, std::fabs(s[0][0] - std::exp(-t)), std::fabs(s[0][1] - 2 * std::exp(-t))});
+    for (int i = 1; i < 3; ++i)
+      for (int k = 0; k < 2; ++k) unequal += s[i][k] != std::ldexp(s[0][k], i);
+    ++rows;
+  };
+  const IdaStats st = integrate(p, o, y, yp, [](double, const double*, const double*) { return true; });
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_EQ(rows, 21);
+  EXPECT_EQ(unequal, 0);
+  EXPECT_LT(worst, 1e-8);
+}
+
 // Sensitivities that cannot go on stop; the run goes on without them to its end.
 TEST(IdaDriverSensitivities, AFailureStopsThemNotTheRun) {
   DecayProblem p;

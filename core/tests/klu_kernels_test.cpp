@@ -33,7 +33,8 @@ Csc to_csc(const std::vector<double>& dense, int n) {
   return a;
 }
 
-// klu_solve and klu_solve_one on the same factorization and right-hand sides: equal bit for bit.
+// klu_solve and klu_solve_one on the same factorization and right-hand sides: equal bit for bit;
+// klu_solve_many too.
 // Returns the number of diagonal blocks KLU's analysis found.
 int expect_same_solutions(Csc a, int scale, int btf, std::mt19937& rng) {
   klu_common common;
@@ -53,6 +54,20 @@ int expect_same_solutions(Csc a, int scale, int btf, std::mt19937& rng) {
     EXPECT_TRUE(klu_solve(s, f, a.n, 1, b.data(), &common));
     klu_solve_one(*s, *f, x.data());
     EXPECT_EQ(std::memcmp(b.data(), x.data(), a.n * sizeof(double)), 0) << "trial " << trial;
+  }
+  // klu_solve_many on 1 to 9 right-hand sides (chunks of four, three, two and one): each equal
+  // bit for bit to klu_solve_one on it.
+  for (int nrhs = 1; nrhs <= 9; ++nrhs) {
+    std::vector<std::vector<double>> many(nrhs, std::vector<double>(a.n)), one = many;
+    std::vector<double*> ptrs;
+    for (int r = 0; r < nrhs; ++r) {
+      for (int i = 0; i < a.n; ++i) many[r][i] = one[r][i] = u(rng) * std::pow(10.0, static_cast<int>(u(rng) * 2));
+      klu_solve_one(*s, *f, one[r].data());
+      ptrs.push_back(many[r].data());
+    }
+    klu_solve_many(*s, *f, ptrs.data(), nrhs);
+    for (int r = 0; r < nrhs; ++r)
+      EXPECT_EQ(std::memcmp(many[r].data(), one[r].data(), a.n * sizeof(double)), 0) << nrhs << " right-hand sides, " << r;
   }
   const int blocks = s->nblocks;
   klu_free_numeric(&f, &common);

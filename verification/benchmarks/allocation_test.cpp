@@ -97,10 +97,11 @@ void expect_none_in_the_step_loop(bool reduced_newton) {
 }
 
 // The step loop of IDAS with sensitivities (their vector arrays, their residual and solves), on
-// the decay of core/tests/decay_problem.h and its sensitivity to the initial value.
+// the decay of core/tests/decay_problem.h and three copies of its sensitivity to the initial value.
 TEST(Allocations, NoneInTheStepLoopWithSensitivities) {
   testing::DecayProblem p;
   testing::DecayInitialValue sens;
+  sens.copies = 3;  // several: their solves batched
   std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
   IdaOptions o;
   o.t1 = 20;
