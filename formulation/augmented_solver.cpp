@@ -97,6 +97,7 @@ bool AugmentedSolver::output_accelerations(const std::vector<char>& modes, const
   }
   if (!refined && !solve_accelerations(klu_output_, modes, q, v, t)) return false;
   ++(refined ? refinement.refined : refinement.direct);
+  last_output_direct_ = !refined;
   remember_output(t);
   std::copy(rhs_.begin(), rhs_.begin() + nq_, a);
   return true;
@@ -187,66 +188,94 @@ void AugmentedSolver::choose_extrapolation_order(double t) {
 
 // r = b - K x without assembling K: M a + Phi_q^T lambda and Phi_q a, from the constraint rows in
 // rows_ (evaluated once per sample).
-void AugmentedSolver::acceleration_residual(const double* q, const double* x, double* r) const {
+void AugmentedSolver::acceleration_residual(const double* q, const double* b, const double* x, double* r) const {
   mass_times(sys_, q, x, r);
   constraint_rows_products(phi_, rows_, x, x + nq_, r, r + nq_);
-  for (int i = 0; i < nq_ + nc_; ++i) r[i] = rhs_[i] - r[i];
+  for (int i = 0; i < nq_ + nc_; ++i) r[i] = b[i] - r[i];
 }
 
-// From the extrapolated x: r = b - K x (b in rhs_), dx = K0^-1 r, x += dx. The
-// iteration contracts by rho = |K0^-1 (K - K0)| per correction (small for nearby states); the
-// error left after a correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio
-// of successive corrections (per block, a and lambda). Accepted when that estimate is below
-// `tolerance` of the block's max norm (for a, or the rounding of the applied forces, 1e3 eps
-// |Q| / m); a slow (rho > 0.5) or diverging iteration is not.
 bool AugmentedSolver::refine_accelerations(const double* q, double t, double tolerance) {
-  const int n = nq_ + nc_;
   double* x = work2_.data();
   predict_accelerations(t, std::min(points_, history_size_), x);
   constraint_jacobian_rows(sys_, q, rows_);
+  if (!refine(q, rhs_.data(), x, t, tolerance)) return false;
+  std::copy(work2_.begin(), work2_.end(), rhs_.begin());
+  return true;
+}
+
+// From x: r = b - K x, dx = K0^-1 r, x += dx (K from rows_ at q). The iteration contracts by
+// rho = |K0^-1 (K - K0)| per correction (small for nearby states); the error left after a
+// correction dx is about rho / (1 - rho) |dx|, with rho measured as the ratio of successive
+// corrections (per block, a and lambda). Accepted when that estimate is below `tolerance` of the
+// block's max norm (for a, or the rounding of b's forces, 1e3 eps |b_Q| / m); a slow (rho > 0.5)
+// or diverging iteration is not.
+bool AugmentedSolver::refine(const double* q, const double* b, double* x, double t, double tolerance) {
+  const int n = nq_ + nc_;
   // The accelerations cannot be resolved below the rounding of the force balance, about eps |Q| / m
   // (gravity for a body it pulls): a mechanism at rest has a = 0 up to that rounding, and a
   // tolerance relative to |a| alone could never be met there (every sample would fall back to
   // the direct solve). So a is accepted at that rounding (1e3 eps |Q| / m) when it is the larger.
   double floor[2] = {0, 0};
-  for (int b = 0; b < sys_.num_bodies(); ++b)
-    if (sys_.bodies[b].mass > 0)
-      for (int k = 0; k < 3; ++k) floor[0] = std::max(floor[0], std::fabs(rhs_[7 * b + k]) / sys_.bodies[b].mass);
+  for (int body = 0; body < sys_.num_bodies(); ++body)
+    if (sys_.bodies[body].mass > 0)
+      for (int k = 0; k < 3; ++k) floor[0] = std::max(floor[0], std::fabs(b[7 * body + k]) / sys_.bodies[body].mass);
   floor[0] *= 1e3 * 2.220446049250313e-16;
   double last_dx[2] = {0, 0};
   for (int it = 0; it < kMaxRefinements; ++it) {
-    acceleration_residual(q, x, work_.data());
+    acceleration_residual(q, b, x, work_.data());
     if (!klu_output_.solve(work_.data())) return false;
     ++refinement.corrections;
     double dx[2] = {0, 0}, xmax[2] = {0, 0};
     for (int i = 0; i < n; ++i) {
       x[i] += work_[i];
-      const int b = i >= nq_;
+      const int blk = i >= nq_;
       // std::max is inlined (std::fmax is a libm call); as with fmax a NaN is skipped here and
       // caught by check_overflow.
-      dx[b] = std::max(dx[b], std::fabs(work_[i]));
-      xmax[b] = std::max(xmax[b], std::fabs(x[i]));
+      dx[blk] = std::max(dx[blk], std::fabs(work_[i]));
+      xmax[blk] = std::max(xmax[blk], std::fabs(x[i]));
     }
     if (!std::isfinite(dx[0] + dx[1] + xmax[0] + xmax[1])) return false;
     bool converged = true, hopeless = false;
-    for (int b = 0; b < 2; ++b) {
-      const double rho = it > 0 && last_dx[b] > 0 ? dx[b] / last_dx[b] : 1.0;
-      const double error = rho <= 0.5 ? rho / (1 - rho) * dx[b] : INFINITY;
-      const double allowed = std::max(tolerance * xmax[b], floor[b]);
-      converged = converged && (dx[b] == 0 || error <= allowed);
+    for (int blk = 0; blk < 2; ++blk) {
+      const double rho = it > 0 && last_dx[blk] > 0 ? dx[blk] / last_dx[blk] : 1.0;
+      const double error = rho <= 0.5 ? rho / (1 - rho) * dx[blk] : INFINITY;
+      const double allowed = std::max(tolerance * xmax[blk], floor[blk]);
+      converged = converged && (dx[blk] == 0 || error <= allowed);
       // Not within the corrections left at this rate: the direct solve is cheaper.
       hopeless = hopeless || (it > 0 && error * std::pow(rho, kMaxRefinements - 1 - it) > allowed);
-      last_dx[b] = dx[b];
+      last_dx[blk] = dx[blk];
     }
     if (hopeless && !converged) return false;
     if (converged) {
       check_overflow(x, n, t, "the accelerations and constraint forces",
                      "a force against a small mass or inertia");
-      std::copy(work2_.begin(), work2_.end(), rhs_.begin());
       return true;
     }
   }
   return false;
+}
+
+void AugmentedSolver::acceleration_system_residual(const std::vector<char>& modes, const double* q,
+                                                   const double* v, double t, const double* x, double* r) {
+  acceleration_right_side(modes, q, v, t);
+  constraint_jacobian_rows(sys_, q, rows_);
+  acceleration_residual(q, rhs_.data(), x, r);
+}
+
+const double* AugmentedSolver::last_output(double t) const {
+  return output_prepared_ && history_size_ > 0 && history_t_[0] == t ? history_[0].data() : nullptr;
+}
+
+bool AugmentedSolver::output_derivative(const double* q, double t, const double* g, double* dx, double tolerance) {
+  const int n = nq_ + nc_;
+  if (!klu_output_.factored()) return false;
+  if (last_output_direct_) {  // K0 is K: one solve
+    std::copy(g, g + n, dx);
+    if (!klu_output_.solve(dx)) return false;
+    check_overflow(dx, n, t, "the accelerations' sensitivities", "a force against a small mass or inertia");
+    return true;
+  }
+  return refine(q, g, dx, t, tolerance);  // rows_ are the sample's (refine_accelerations)
 }
 
 void AugmentedSolver::check_overflow(const double* x, int n, double t, const char* what,

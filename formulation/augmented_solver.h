@@ -51,6 +51,16 @@ class AugmentedSolver {
     long refined = 0, direct = 0, corrections = 0;
   } refinement;
   int extrapolation_points() const { return points_; }  // samples the next extrapolation uses
+  // For the sensitivities of an output sample (formulation/twin_sensitivities.cpp): r = b - K x
+  // of the acceleration system at (q, v, t) for a given x = [a; lambda]; the last output sample's
+  // [a; lambda] if it was at t (else null); and dx with K dx = g, K that sample's matrix (q its
+  // positions), on its factorization: one solve where K0 was factored at that sample, else
+  // refined as that sample was from the guess in dx (false where the refinement does not
+  // converge).
+  void acceleration_system_residual(const std::vector<char>& modes, const double* q, const double* v, double t,
+                                    const double* x, double* r);
+  const double* last_output(double t) const;
+  bool output_derivative(const double* q, double t, const double* g, double* dx, double tolerance);
   bool velocities(const double* q, double t, double* v);
   PositionSolveResult positions(double* q, double t, double tol = 1e-13, int max_iter = 100,
                                 double regularization = 0.0);
@@ -72,8 +82,9 @@ class AugmentedSolver {
   void predict_accelerations(double t, int points, double* x) const;
   void choose_extrapolation_order(double t);
   void acceleration_right_side(const std::vector<char>& modes, const double* q, const double* v, double t);
-  void acceleration_residual(const double* q, const double* x, double* r) const;
+  void acceleration_residual(const double* q, const double* b, const double* x, double* r) const;
   bool refine_accelerations(const double* q, double t, double tolerance);
+  bool refine(const double* q, const double* b, double* x, double t, double tolerance);
   void remember_output(double t);
   void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
   const System& sys_;
@@ -86,6 +97,7 @@ class AugmentedSolver {
   ConstraintRowsPattern phi_;  // their structural entries (the products with Phi_q)
   KluSolver klu_output_;  // output samples' acceleration matrix K0
   bool output_prepared_ = false;
+  bool last_output_direct_ = false;  // the last output sample factored K0 at its own state
   // The last output solutions [a; lambda] and their times (history_[0] the newest), and how many
   // of them the next extrapolation goes through.
   static constexpr int kHistory = 8;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/finite_check.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
 
@@ -30,6 +31,10 @@ TwinSensitivities::TwinSensitivities(MultibodyDae& run, std::unique_ptr<Multibod
   ypt_.resize(n);
   rp_.resize(n);
   rm_.resize(n);
+  const int nq = run_.nq(), nx = nq + run_.nc();
+  for (auto* v : {&qp_, &qm_, &vp_, &vm_, &at_}) v->resize(nq);
+  g_.resize(nx);
+  xp_.resize(nx);
   sp_plus_.resize(run_.system().sensors.size());
   sp_minus_.resize(run_.system().sensors.size());
 }
@@ -191,28 +196,85 @@ void TwinSensitivities::restart(double t, const double* y, const double* yp, dou
 
 bool TwinSensitivities::sensors(double t, const double* y, const double* yp, const double* const* s,
                                 const double* const* sp, bool project, std::vector<std::vector<double>>& out) {
-  const int n = run_.size();
   out.resize(twins_.size());
+  const bool derivative = !project && run_.state().output.accelerations &&
+                          run_.augmented().last_output(run_.input_time(t)) != nullptr;
   for (size_t i = 0; i < twins_.size(); ++i) {
-    ParameterTwins& p = twins_[i];
-    for (int sign = 1; sign >= -1; sign -= 2) {
-      MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
-      follow(twin);
-      for (int k = 0; k < n; ++k) {
-        yt_[k] = y[k] + sign * p.delta * s[i][k];
-        if (yp) ypt_[k] = yp[k] + sign * p.delta * sp[i][k];
-      }
-      twin.state().output = run_.state().output;
-      twin.consistent_output(t, yt_.data(), yp ? ypt_.data() : nullptr, qo_, vo_, ao_, project);
-      if (!twin.state().output_failure.empty()) {
-        failure_ = twin.state().output_failure;
-        return false;
-      }
-      evaluate_sensors(twin.system(), twin.state().modes, qo_.data(), vo_.data(), ao_.empty() ? nullptr : ao_.data(),
-                       twin.input_time(t), sign > 0 ? sp_plus_.data() : sp_minus_.data(), nullptr, &twin.state().turns);
-    }
+    if (!(derivative && sensors_by_derivative(t, y, yp, s[i], sp ? sp[i] : nullptr, twins_[i])) &&
+        !sensors_by_twins(t, y, yp, s[i], sp ? sp[i] : nullptr, project, twins_[i]))
+      return false;
     out[i].resize(sp_plus_.size());
-    for (size_t k = 0; k < sp_plus_.size(); ++k) out[i][k] = (sp_plus_[k] - sp_minus_[k]) / (2 * p.delta);
+    for (size_t k = 0; k < sp_plus_.size(); ++k) out[i][k] = (sp_plus_[k] - sp_minus_[k]) / (2 * twins_[i].delta);
+  }
+  return true;
+}
+
+// The twins' own consistent outputs at y +- d s (each its accelerations' solve), their sensors
+// into sp_plus_ and sp_minus_.
+bool TwinSensitivities::sensors_by_twins(double t, const double* y, const double* yp, const double* s,
+                                         const double* sp, bool project, ParameterTwins& p) {
+  const int n = run_.size();
+  for (int sign = 1; sign >= -1; sign -= 2) {
+    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+    follow(twin);
+    for (int k = 0; k < n; ++k) {
+      yt_[k] = y[k] + sign * p.delta * s[k];
+      if (yp) ypt_[k] = yp[k] + sign * p.delta * sp[k];
+    }
+    twin.state().output = run_.state().output;
+    twin.consistent_output(t, yt_.data(), yp ? ypt_.data() : nullptr, qo_, vo_, ao_, project);
+    if (!twin.state().output_failure.empty()) {
+      failure_ = twin.state().output_failure;
+      return false;
+    }
+    evaluate_sensors(twin.system(), twin.state().modes, qo_.data(), vo_.data(), ao_.empty() ? nullptr : ao_.data(),
+                     twin.input_time(t), sign > 0 ? sp_plus_.data() : sp_minus_.data(), nullptr, &twin.state().turns);
+  }
+  return true;
+}
+
+// The accelerations' and multipliers' sensitivity x_p from the run's own output solve: with
+// r(q, v, x; p) = b - K x the acceleration system's residual (zero at the run's sample),
+// K x_p = dr/dp along (s_q, s_v) at the run's x, that derivative the twins' central difference
+// of r at (q +- d s_q, v +- d s_v) with x held; K x_p = g solved on the run's factorization of the
+// sample (AugmentedSolver::output_derivative). The twins' sensors then at x +- d x_p. Two
+// residuals of the acceleration system per twin pair and one solve with refinement, where the
+// twins' own outputs cost each a solve with its refinement (docs/sensitivities.md, Cost). False
+// where the refinement does not converge (the twins' outputs are taken then).
+bool TwinSensitivities::sensors_by_derivative(double t, const double* y, const double* yp, const double* s,
+                                              const double* sp, ParameterTwins& p) {
+  AugmentedSolver& aug = run_.augmented();
+  const double t_run = run_.input_time(t);
+  const double* x = aug.last_output(t_run);
+  const int nq = run_.nq(), nx = nq + run_.nc();
+  const bool v_from_state = run_.output_velocities_from_state();
+  if (!v_from_state && !yp) return false;
+  for (int sign = 1; sign >= -1; sign -= 2) {
+    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+    follow(twin);
+    double* q = sign > 0 ? qp_.data() : qm_.data();
+    double* v = sign > 0 ? vp_.data() : vm_.data();
+    for (int k = 0; k < nq; ++k) {
+      q[k] = y[k] + sign * p.delta * s[k];
+      v[k] = v_from_state ? y[nq + k] + sign * p.delta * s[nq + k] : yp[k] + sign * p.delta * sp[k];
+    }
+    if (first_non_finite(q, nq) >= 0 || first_non_finite(v, nq) >= 0) return false;
+    twin.augmented().acceleration_system_residual(twin.state().modes, q, v, twin.input_time(t), x,
+                                                  sign > 0 ? rp_.data() : rm_.data());
+  }
+  for (int k = 0; k < nx; ++k) g_[k] = (rp_[k] - rm_[k]) / (2 * p.delta);
+  // The refinement's guess: IDAS's interpolated s' of v (x_p's accelerations) and s of lambda,
+  // where y = [q, v, lambda, ...] (a guess only: the refinement decides).
+  const bool guess = sp && run_.size() >= 2 * nq + (nx - nq);
+  for (int k = 0; k < nx; ++k) xp_[k] = !guess ? 0.0 : k < nq ? sp[nq + k] : s[nq + k];
+  if (!aug.output_derivative(y, t_run, g_.data(), xp_.data(), run_.state().output.acceleration_tolerance))
+    return false;
+  for (int sign = 1; sign >= -1; sign -= 2) {
+    MultibodyDae& twin = sign > 0 ? *p.plus : *p.minus;
+    for (int k = 0; k < nq; ++k) at_[k] = x[k] + sign * p.delta * xp_[k];
+    evaluate_sensors(twin.system(), twin.state().modes, sign > 0 ? qp_.data() : qm_.data(),
+                     sign > 0 ? vp_.data() : vm_.data(), at_.data(), twin.input_time(t),
+                     sign > 0 ? sp_plus_.data() : sp_minus_.data(), nullptr, &twin.state().turns);
   }
   return true;
 }

@@ -70,9 +70,10 @@ class TwinSensitivities : public SensitivityProblem {
   void jump_at_breakpoint(double t, const double* yp_before, const double* yp_after, double* const* s) override;
   bool in_error_test() const override { return in_error_test_; }
   bool reads_state_residual() const override { return false; }
-  // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' consistent
-  // output (projected when `project`) and sensors at y +- d s_i. False, with `failure` set,
-  // when a twin's output state cannot be formed.
+  // d(sensor k)/d(p_i) at a sample (out[i][k], sys.sensors order): the twins' sensors at
+  // y +- d s_i, with accelerations from the run's own output solve (sensors_by_derivative;
+  // called after the run's output sample at t) or, projected when `project`, the twins' own
+  // consistent outputs. False, with `failure` set, when a twin's output state cannot be formed.
   bool sensors(double t, const double* y, const double* yp, const double* const* s, const double* const* sp,
                bool project, std::vector<std::vector<double>>& out);
   const std::string& failure() const { return failure_; }
@@ -84,6 +85,10 @@ class TwinSensitivities : public SensitivityProblem {
   int add_reached_difference(double t, const double* y, const double* yp, ParameterTwins& p, double* r);
 
   int run_breakpoint(double t) const;  // the index of t among the run's breakpoints, or -1
+  bool sensors_by_twins(double t, const double* y, const double* yp, const double* s, const double* sp, bool project,
+                        ParameterTwins& p);
+  bool sensors_by_derivative(double t, const double* y, const double* yp, const double* s, const double* sp,
+                             ParameterTwins& p);
 
   MultibodyDae& run_;
   std::vector<double> breakpoints_;  // the run's
@@ -92,6 +97,7 @@ class TwinSensitivities : public SensitivityProblem {
   bool in_error_test_;
   std::vector<double> yt_, ypt_, rp_, rm_;  // work (size of the DAE)
   std::vector<double> qo_, vo_, ao_, sp_plus_, sp_minus_;
+  std::vector<double> qp_, qm_, vp_, vm_, at_, g_, xp_;  // sensors_by_derivative's work
   std::string failure_;
 };
 

@@ -1,7 +1,7 @@
 // Sensitivities (RunOptions::sensitivities, docs/sensitivities.md) against closed forms, through
-// the public API and the executable: a damped oscillator's position and velocity against its
-// stiffness, damping, mass and initial position for every formulation; the IFToMM A01 pendulum
-// against its length (Jacobi's exact solution); bad requests refused before any run, the files
+// the public API and the executable: a damped oscillator's position, velocity and acceleration
+// against its stiffness, damping, mass and initial position for every formulation; the IFToMM
+// A01 pendulum's position and acceleration against its length (Jacobi's exact solution); bad requests refused before any run, the files
 // and summary entries of `mbdae run --sensitivity`.
 #include <gtest/gtest.h>
 
@@ -72,7 +72,10 @@ TEST(Sensitivities, DampedOscillatorMatchesItsClosedFormInEveryFormulation) {
     SCOPED_TRACE(form);
     RunOptions opt;
     opt.sensitivities.assign(std::begin(paths), std::end(paths));
-    const Result r = run(load_scene_text(oscillator(form), "oscillator.yaml"), opt);
+    std::string text = oscillator(form);
+    const std::string vz = "  - {name: vz, type: velocity, body: slider, component: z}\n";
+    text.replace(text.find(vz), vz.size(), vz + "  - {name: az, type: acceleration, body: slider, component: z}\n");
+    const Result r = run(load_scene_text(text, "oscillator.yaml"), opt);
     ASSERT_TRUE(r.ok()) << r.message;
     ASSERT_EQ(r.sensitivities[0].size(), r.rows());
     EXPECT_EQ(r.summary["sensitivities"]["status"], "ok");
@@ -83,7 +86,7 @@ TEST(Sensitivities, DampedOscillatorMatchesItsClosedFormInEveryFormulation) {
     EXPECT_EQ(step["formulation"], handed ? "index2-ggl" : form);
     EXPECT_EQ(step.contains("formulation_with_sensitivities") || step.contains("formulation_handover"), handed);
     for (int which = 0; which < 4; ++which) {
-      for (int sensor = 0; sensor < 2; ++sensor) {
+      for (int sensor = 0; sensor < 3; ++sensor) {
         auto reference = [&](double t) {
           Oscillator o;
           double* p[] = {&o.K, &o.C, &o.m, &o.z0};
@@ -93,10 +96,11 @@ TEST(Sensitivities, DampedOscillatorMatchesItsClosedFormInEveryFormulation) {
             *q[which] = value;
             double z, v;
             x.at(t, z, v);
-            return sensor == 0 ? z : v;
+            return sensor == 0 ? z : sensor == 1 ? v : (-x.K * z - x.C * v) / x.m;
           }, *p[which]);
         };
-        const std::string column = std::string("d(") + (sensor == 0 ? "z" : "vz") + ")/d(" + paths[which] + ")";
+        const char* names[] = {"z", "vz", "az"};
+        const std::string column = std::string("d(") + names[sensor] + ")/d(" + paths[which] + ")";
         // Measured: 2e-9 to 3e-7 of the largest sensitivity (penalty: its constraint bias).
         EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
       }
@@ -118,6 +122,8 @@ coordinates:
 sensors:
   - {name: x, type: position, body: link, point: com, component: x}
   - {name: y, type: position, body: link, point: com, component: y}
+  - {name: ax, type: acceleration, body: link, point: com, component: x}
+  - {name: ay, type: acceleration, body: link, point: com, component: y}
 analysis:
   - {type: dynamics, t_end: 10, output_step: 0.05, rtol: 1.0e-10}
 )";
@@ -125,16 +131,21 @@ analysis:
   opt.sensitivities = {"bodies.link.com.0"};
   const Result r = run(load_scene_text(text, "a01.yaml"), opt);
   ASSERT_TRUE(r.ok()) << r.message;
-  for (int sensor = 0; sensor < 2; ++sensor) {
+  const char* names[] = {"x", "y", "ax", "ay"};
+  for (int sensor = 0; sensor < 4; ++sensor) {
+    // The accelerations from the energy (phi'^2 = 2 g / L cos phi, phi'' = -g / L sin phi):
+    // x'' = -3 g sin phi cos phi, y'' = g (2 cos^2 phi - sin^2 phi), L only through phi(t).
     auto reference = [&](double t) {
       return closed_form_derivative([&](double length) {
         PendulumExact p;
         p.length = length;
         p.w0 = std::sqrt(9.81 / length);
-        return sensor == 0 ? p.x(t) : p.y(t);
+        const double phi = p.phi(t), c = std::cos(phi), s = std::sin(phi);
+        const double values[] = {p.x(t), p.y(t), -3 * 9.81 * s * c, 9.81 * (2 * c * c - s * s)};
+        return values[sensor];
       }, 1.0);
     };
-    const std::string column = std::string("d(") + (sensor == 0 ? "x" : "y") + ")/d(bodies.link.com.0)";
+    const std::string column = std::string("d(") + names[sensor] + ")/d(bodies.link.com.0)";
     EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
   }
 }
