@@ -21,8 +21,10 @@
 // structure, or reaches a constraint and the formulation gives no constraint terms
 // (formulation/parameter_reach.h); a force's stiffness, a body's mass, gravity or a hardpoint
 // difference just the terms they reach, the same central difference without the cancelling rest.
-// Consistent (s, s') at a restart and the sensors' sensitivities at a sample are central
-// differences of the twins' own consistent values and sensors at y +- d s.
+// Consistent (s, s') at a restart are central differences of the twins' own consistent values
+// at y +- d s; the sensors' sensitivities at a sample the twins' sensors at y +- d s with the
+// accelerations' sensitivity solved on the run's own output factorization (sensors_by_derivative;
+// the twins' own consistent outputs where that is not possible).
 // A parameter that moves a breakpoint t_b (the time of an input's jump: a ground step, a point
 // force's step): each twin keeps its own breakpoint, the run's segment mapped onto the twin's
 // (its inputs held at their left limit before its t_b and at their right limit after it, so
