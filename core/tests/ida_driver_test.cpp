@@ -224,11 +224,7 @@ TEST(IdaDriverSensitivities, FollowTheClosedFormThroughABreakpoint) {
   p.step_input = true;  // a breakpoint at 0.5: the sensitivities restart there
   DecayInitialValue sens;
   std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
-  IdaOptions o;
-  o.t1 = 2;
-  o.rtol = 1e-10;
-  o.atol = 1e-12;
-  o.output_step = 0.1;
+  IdaOptions o = decay_options();
   o.sensitivities = &sens;
   double worst = 0;
   int rows = 0;
@@ -253,11 +249,7 @@ TEST(IdaDriverSensitivities, SeveralAreSolvedTogetherAndEachIsItsOwn) {
   DecayInitialValue sens;
   sens.copies = 3;
   std::vector<double> y = {1.0, 2.0}, yp = {-1.0, -2.0};
-  IdaOptions o;
-  o.t1 = 2;
-  o.rtol = 1e-10;
-  o.atol = 1e-12;
-  o.output_step = 0.1;
+  IdaOptions o = decay_options();
   o.sensitivities = &sens;
   double worst = 0;
   int rows = 0, unequal = 0;
