@@ -2,22 +2,25 @@
 // by the implicit function theorem, without integrating them (docs/sensitivities.md):
 //
 //   Phi(q, t; p) = 0          =>  Phi_q s_q = -dPhi/dp
-//   Phi_q v + Phi_t = 0       =>  Phi_q s_v = -[d(Phi_q v + Phi_t)/dq s_q + d(Phi_q v + Phi_t)/dp]
+//   Phi_q v + Phi_t = 0       =>  Phi_q s_v = -[(H v) s_q + d(Phi_q v + Phi_t)/dp]
 //
-// at the sample's consistent (q, v). Phi_q is factorized once per sample (Eigen's SparseLU, its
-// pattern analysed once); the right sides are central differences over the twin models'
-// constraint values (at q, and at q +- d s_q with v), so each parameter costs two
-// back-substitutions and a few constraint evaluations; the sensors' sensitivities are central
+// at the sample's consistent (q, v), (H v) s_q the rows' Hessians along s_q (exact: the
+// constraint library's closed forms, else its row Hessians; Phi_t depends on t alone).
+// Phi_q is factorized once per sample (KLU, its pattern analysed once), and the right sides of
+// all parameters are solved together (two passes over the factors per sample: positions, then
+// velocities). dPhi/dp and d(Phi_q v + Phi_t)/dp are central differences of the twin models'
+// constraints, over the constraints the parameter reaches (formulation/parameter_reach.h; all
+// of them where it changes the model's structure). The sensors' sensitivities are central
 // differences of the twins' sensors at (q +- d s_q, v +- d s_v).
 #pragma once
-
-#include <Eigen/SparseLU>
 
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/klu_solver.h"
 #include "core/sparse_assembler.h"
+#include "formulation/parameter_reach.h"
 #include "formulation/system.h"
 
 namespace mbdae {
@@ -37,14 +40,19 @@ class KinematicSensitivities {
 
  private:
   bool factorize(const double* q);
+  void position_side(size_t i, const double* q, double t, double* rhs);
+  void velocity_sides(const double* q, const double* v, double t);  // into sv_, from sq_
   const System& run_;
   std::vector<std::pair<const System*, const System*>> twins_;
   std::vector<double> deltas_;
+  std::vector<ParameterReach> reach_;
   std::vector<int> offsets_;
-  SparseAssembler asm_;  // Phi_q's pattern, recorded once; its values assembled into phi_q_
-  Eigen::SparseMatrix<double> phi_q_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
-  Eigen::VectorXd rhs_, sq_, sv_;
+  SparseAssembler asm_;  // Phi_q's pattern, recorded once; its values assembled into values_
+  std::vector<double> values_;
+  KluSolver klu_;
+  // Per parameter: s_q and s_v (the right sides, solved in place), n values each.
+  std::vector<double> sq_, sv_;
+  std::vector<double*> sq_cols_, sv_cols_;
   std::vector<double> a_, b_, qt_, vt_, yp_, ym_;
   std::string failure_;
 };

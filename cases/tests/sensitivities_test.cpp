@@ -1,7 +1,8 @@
 // Sensitivities (RunOptions::sensitivities, docs/sensitivities.md) against closed forms, through
 // the public API and the executable: a damped oscillator's position, velocity and acceleration
 // against its stiffness, damping, mass and initial position for every formulation; the IFToMM
-// A01 pendulum's position and acceleration against its length (Jacobi's exact solution); bad requests refused before any run, the files
+// A01 pendulum's position and acceleration against its length (Jacobi's exact solution); a
+// kinematic slider-crank's piston position and rate against its crank and rod lengths; bad requests refused before any run, the files
 // and summary entries of `mbdae run --sensitivity`.
 #include <gtest/gtest.h>
 
@@ -148,6 +149,34 @@ analysis:
     const std::string column = std::string("d(") + names[sensor] + ")/d(bodies.link.com.0)";
     EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
   }
+}
+
+// A kinematic run (every degree of freedom driven: the implicit function theorem at each sample,
+// formulation/kinematic_sensitivities.h): the slider-crank of verification/engine, its piston's
+// position and rate against the crank radius r and the rod length l, two hardpoint coordinates
+// that its joint and its cut hold, in closed form: x = r cos(wt) + sqrt(l^2 - r^2 sin^2(wt)).
+TEST(Sensitivities, SliderCrankPistonAgainstCrankAndRodInClosedForm) {
+  const Scene s = load_scene(std::string(MBDAE_SOURCE_DIR) + "/verification/engine/scenes/slider_crank.yaml");
+  const char* paths[] = {"bodies.crank.points.pin.0", "bodies.rod.points.end.0"};
+  RunOptions opt;
+  opt.sensitivities.assign(std::begin(paths), std::end(paths));
+  const Result r = run(s, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  const std::string method = r.summary["steps"].back().value("sensitivity_method", "");
+  EXPECT_NE(method.find("implicit function theorem"), std::string::npos) << method;
+  const double w = 2 * 3.14159265358979323846;
+  for (int which = 0; which < 2; ++which)
+    for (int rate = 0; rate < 2; ++rate) {
+      auto reference = [&](double t) {
+        return closed_form_derivative([&](double value) {
+          const double rr = which == 0 ? value : 0.1, l = which == 1 ? value : 0.35;
+          const double c = std::cos(w * t), sn = std::sin(w * t), root = std::sqrt(l * l - rr * rr * sn * sn);
+          return rate == 0 ? rr * c + root : -rr * w * sn - rr * rr * w * sn * c / root;
+        }, which == 0 ? 0.1 : 0.35);
+      };
+      const std::string column = std::string("d(") + (rate == 0 ? "x" : "x_rate") + ")/d(" + paths[which] + ")";
+      EXPECT_LT(relative_error(r, column, reference), 1e-6) << column;
+    }
 }
 
 TEST(Sensitivities, BadRequestsAreRefusedBeforeTheRun) {
