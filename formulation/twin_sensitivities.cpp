@@ -265,7 +265,7 @@ bool TwinSensitivities::sensors_by_derivative(double t, const double* y, const d
   for (int k = 0; k < nx; ++k) g_[k] = (rp_[k] - rm_[k]) / (2 * p.delta);
   // The refinement's guess: IDAS's interpolated s' of v (x_p's accelerations) and s of lambda,
   // where y = [q, v, lambda, ...] (a guess only: the refinement decides).
-  const bool guess = sp && run_.size() >= 2 * nq + (nx - nq);
+  const bool guess = sp && run_.size() >= 2 * nq + run_.nc();
   for (int k = 0; k < nx; ++k) xp_[k] = !guess ? 0.0 : k < nq ? sp[nq + k] : s[nq + k];
   if (!aug.output_derivative(y, t_run, g_.data(), xp_.data(), run_.state().output.acceleration_tolerance))
     return false;

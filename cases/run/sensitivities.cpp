@@ -361,7 +361,11 @@ void record_sensitivity_sample(RunContext& c, TwinSensitivities& ts, double t, c
                                const double* const* s, const double* const* sp, bool project) {
   RunSensitivities& rs = *c.sensitivities;
   if (!rs.active || !wrote_row(c, t)) return;
-  if (!ts.sensors(t, y, yp, s, sp, project, rs.sensor_work)) return sensitivities_failed(c, "output_failed", ts.failure());
+  try {
+    if (!ts.sensors(t, y, yp, s, sp, project, rs.sensor_work)) return sensitivities_failed(c, "output_failed", ts.failure());
+  } catch (const SolveError& e) {  // a twin's loads not finite at y +- d s: the sensitivities stop, the run goes on
+    return sensitivities_failed(c, "output_failed", "at t = " + number_text(t) + ": " + e.what());
+  }
   record_sensitivity_row(c, t, s);
 }
 
