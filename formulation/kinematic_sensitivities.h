@@ -7,8 +7,8 @@
 // at the sample's consistent (q, v), (H v) s_q the rows' Hessians along s_q (exact: the
 // constraint library's closed forms, else its row Hessians; Phi_t depends on t alone).
 // Phi_q is factorized once per sample (KLU, its pattern analysed once), and the right sides of
-// all parameters are solved together (two passes over the factors per sample: positions, then
-// velocities). dPhi/dp and d(Phi_q v + Phi_t)/dp are central differences of the twin models'
+// all parameters are solved together, positions then velocities (klu_solve_many: a pass over
+// the factors per four parameters). dPhi/dp and d(Phi_q v + Phi_t)/dp are central differences of the twin models'
 // constraints, over the constraints the parameter reaches (formulation/parameter_reach.h; all
 // of them where it changes the model's structure). The sensors' sensitivities are central
 // differences of the twins' sensors at (q +- d s_q, v +- d s_v).
