@@ -220,6 +220,25 @@ void assemble_inertia_derivatives(const System& sys, const double* q, const doub
   }
 }
 
+void inertia_derivatives_times(const System& sys, const double* q, const double* v, const double* acc, int row0,
+                               int colq, int colv, int count, const double* const* x, double* const* out) {
+  for (int b = 0; b < sys.num_bodies(); ++b) {
+    const Mat3& j = sys.bodies[b].inertia;
+    const int o = 7 * b + 3;
+    const Vec4 p = p_of(q, b), pd = p_of(v, b), pdd = p_of(acc, b);
+    const Mat34 l = L_matrix(p), ld = L_matrix(pd), la = L_matrix(pdd);
+    const Vec3 jla = j * (l * pdd), jlpd = j * (l * pd);
+    for (int i = 0; i < count; ++i) {
+      const Vec4 xq = Eigen::Map<const Vec4>(x[i] + colq + o), xv = Eigen::Map<const Vec4>(x[i] + colv + o);
+      // As assemble_inertia_derivatives' blocks times (xq, xv), with P(w) x = L(x)^T w.
+      const Vec4 r = 4.0 * (L_matrix(xq).transpose() * jla - l.transpose() * (j * (la * xq))) -
+                     8.0 * ld.transpose() * (j * (ld * xq)) +
+                     8.0 * (L_matrix(xv).transpose() * jlpd + ld.transpose() * (j * (l * xv)));
+      Eigen::Map<Vec4>(out[i] + row0 + o) += r;
+    }
+  }
+}
+
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
                                 int colv, SparseAssembler& a, const CoordinateTurns* turns) {

@@ -81,6 +81,11 @@ void assemble_weights(const System& sys, double wr, double wp, int row0, int col
 void assemble_inertia_derivatives(const System& sys, const double* q, const double* v,
                                   const double* acc, int row0, int colq, int colv,
                                   SparseAssembler& a);
+// The same derivatives times vectors without their blocks: out[i][row0 + k] += the row k of
+// d(M(q) acc)/dq x_q + d(gyro)/dq x_q + d(gyro)/dv x_v, x_q and x_v at colq and colv of x[i]
+// (MultibodyDae::jacobian_times).
+void inertia_derivatives_times(const System& sys, const double* q, const double* v, const double* acc, int row0,
+                               int colq, int colv, int count, const double* const* x, double* const* out);
 // -dQ/dq at (row0, colq) and -dQ/dv at (row0, colv) for the applied forces.
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
