@@ -87,12 +87,10 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
   const double* mu = lambda + nc_;
   for (int i = 0; i < count; ++i)
     for (int j = 0; j < nq_; ++j) out[i][j] -= x[i][nq_ + j];  // F1: -I (v columns)
-  // F2: d(M v')/dq and the gyroscopic derivatives in closed form, the applied forces' as
-  // assemble() adds them.
+  // F2: d(M v')/dq and the gyroscopic derivatives in closed form, the applied forces' local
+  // Jacobians times the local x.
   inertia_derivatives_times(sys_, q, v, yp + nq_, nq_, 0, nq_, count, x, out);
-  asm_.begin_product(count, x, out);
-  assemble_force_derivatives(sys_, state_.modes, q, v, t, nq_, 0, nq_, asm_, &state_.turns);
-  asm_.end_product();
+  force_derivatives_times(sys_, state_.modes, q, v, t, nq_, 0, nq_, count, x, out, &state_.turns);
   Row14 rows[3];
   Mat14 h[3];
   for (size_t k = 0; k < sys_.constraints.size(); ++k) {

@@ -239,39 +239,94 @@ void inertia_derivatives_times(const System& sys, const double* q, const double*
   }
 }
 
+namespace {
+
+// Force k's local Jacobians (dQ/dpos, dQ/dvel) and, for a load with expression components, the
+// chain through the components to the bodies they read (dQ/d(component), the components'
+// derivatives in `in`).
+struct ForceDerivatives {
+  Mat14 dx, dv;
+  Mat14x3 dqin;
+  LoadInput in;
+};
+
+void force_derivatives(const System& sys, size_t k, const std::vector<char>& modes, const double* q,
+                       const double* v, double t, const CoordinateTurns* turns, ForceDerivatives& d) {
+  const Force& f = sys.forces[k];
+  Vec14 ql = Vec14::Zero();
+  d.dx.setZero();
+  d.dv.setZero();
+  d.in = load_input(sys, f, modes, q, v, t, f.has_expression(), turns);  // a joint spring's turns
+  if (!f.has_expression()) {
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &d.dx, &d.dv, &d.in);
+  } else {
+    d.dqin.setZero();
+    force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &d.dx, &d.dv, &d.in, &d.dqin);
+  }
+}
+
+// The chain's entry of local row l and read body slot (7 r + m): d(Q_l)/d(q), d(Q_l)/d(v).
+inline void chain_entry(const ForceDerivatives& d, int l, int slot, double& wq, double& wv) {
+  wq = wv = 0;
+  for (int c = 0; c < 3; ++c) {
+    wq += d.dqin(l, c) * d.in.dq[c][slot];
+    wv += d.dqin(l, c) * d.in.dv[c][slot];
+  }
+}
+
+}  // namespace
+
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
                                 int colv, SparseAssembler& a, const CoordinateTurns* turns) {
+  ForceDerivatives d;
   for (size_t k = 0; k < sys.forces.size(); ++k) {
     const Force& f = sys.forces[k];
-    Vec14 ql = Vec14::Zero();
-    Mat14 dx = Mat14::Zero(), dv = Mat14::Zero();
-    if (!f.has_expression()) {
-      const LoadInput in = load_input(sys, f, modes, q, v, t, false, turns);  // a joint spring's turns
-      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in);
-    } else {
-      // Chain rule through the expression components to the bodies they read (forces.h).
-      const LoadInput in = load_input(sys, f, modes, q, v, t, true, turns);
-      Mat14x3 dqin = Mat14x3::Zero();
-      force_eval(f, gather(q, f.bi, f.bj), gather(v, f.bi, f.bj), t, modes[k], ql, &dx, &dv, &in, &dqin);
+    force_derivatives(sys, k, modes, q, v, t, turns, d);
+    if (f.has_expression())
       for (size_t r = 0; r < f.reads.size(); ++r)
         for (int m = 0; m < 7; ++m) {
           const int col = 7 * f.reads[r] + m, slot = 7 * static_cast<int>(r) + m;
           for (int l = 0; l < 14; ++l) {
             const int g = global_index(f.bi, f.bj, l);
             if (g < 0) continue;
-            double wq = 0, wv = 0;
-            for (int c = 0; c < 3; ++c) {
-              wq += dqin(l, c) * in.dq[c][slot];
-              wv += dqin(l, c) * in.dv[c][slot];
-            }
+            double wq, wv;
+            chain_entry(d, l, slot, wq, wv);
             a.add(row0 + g, colq + col, -wq);
             if (colv >= 0) a.add(row0 + g, colv + col, -wv);
           }
         }
+    add_local_block(f.bi, f.bj, -d.dx, row0, colq, true, a);
+    if (colv >= 0) add_local_block(f.bi, f.bj, -d.dv, row0, colv, true, a);
+  }
+}
+
+void force_derivatives_times(const System& sys, const std::vector<char>& modes, const double* q, const double* v,
+                             double t, int row0, int colq, int colv, int count, const double* const* x,
+                             double* const* out, const CoordinateTurns* turns) {
+  ForceDerivatives d;
+  for (size_t k = 0; k < sys.forces.size(); ++k) {
+    const Force& f = sys.forces[k];
+    force_derivatives(sys, k, modes, q, v, t, turns, d);
+    for (int i = 0; i < count; ++i) {
+      // The local blocks times the local x (ground's entries zero), scattered to the bodies' rows.
+      Vec14 r = d.dx * gather_local(x[i] + colq, f.bi, f.bj);
+      if (colv >= 0) r += d.dv * gather_local(x[i] + colv, f.bi, f.bj);
+      for (int l = 0; l < 14; ++l) {
+        const int g = global_index(f.bi, f.bj, l);
+        if (g < 0) continue;
+        double sum = r[l];
+        if (f.has_expression())
+          for (size_t rd = 0; rd < f.reads.size(); ++rd)
+            for (int m = 0; m < 7; ++m) {
+              const int col = 7 * f.reads[rd] + m;
+              double wq, wv;
+              chain_entry(d, l, 7 * static_cast<int>(rd) + m, wq, wv);
+              sum += wq * x[i][colq + col] + (colv >= 0 ? wv * x[i][colv + col] : 0.0);
+            }
+        out[i][row0 + g] -= sum;
+      }
     }
-    add_local_block(f.bi, f.bj, -dx, row0, colq, true, a);
-    if (colv >= 0) add_local_block(f.bi, f.bj, -dv, row0, colv, true, a);
   }
 }
 

@@ -90,6 +90,11 @@ void inertia_derivatives_times(const System& sys, const double* q, const double*
 void assemble_force_derivatives(const System& sys, const std::vector<char>& modes,
                                 const double* q, const double* v, double t, int row0, int colq,
                                 int colv, SparseAssembler& a, const CoordinateTurns* turns = nullptr);
+// The same derivatives times vectors without their blocks: out[i][row0 + k] -= row k of
+// dQ/dq x_q + dQ/dv x_v, x_q and x_v at colq and colv of x[i] (MultibodyDae::jacobian_times).
+void force_derivatives_times(const System& sys, const std::vector<char>& modes, const double* q, const double* v,
+                             double t, int row0, int colq, int colv, int count, const double* const* x,
+                             double* const* out, const CoordinateTurns* turns = nullptr);
 // scale * Phi_q at (row0, col0), and/or its transpose at (row0t, col0t) (negative: skip).
 void assemble_constraint_jacobian(const System& sys, const std::vector<int>& offsets,
                                   const double* q, double scale, int row0, int col0, int row0t,

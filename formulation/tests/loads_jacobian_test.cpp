@@ -4,8 +4,13 @@
 // expression loads to the bodies their sensors read).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "formulation/force_types.h"
 #include "formulation/forces.h"
+#include "formulation/ggl_dae.h"
 #include "formulation/index3_dae.h"
 #include "formulation/mechanics.h"
 #include "formulation/sensors.h"
@@ -185,6 +190,38 @@ TEST(LoadsJacobian, Index3NewtonMatrixWithLoads) {
   const testing::NewtonCheck check = testing::check_newton_matrix(dae, random_state(sys, 7), false);
   EXPECT_LT(check.worst, 1e-6) << check.where;
   RecordProperty("worst_relative_error", testing::sci(check.worst));
+}
+
+// index2-ggl's F_y x without the assembly (GglDae::jacobian_times: the forces' local Jacobians
+// times the local x, and the expression loads' chain to the bodies their sensors read) against
+// its assembled Newton matrix at cj = 0 times x, for two x at once.
+TEST(LoadsJacobian, GglJacobianTimesWithLoadsIsTheAssembledMatrixTimesX) {
+  const System sys = build_system(loads_model());
+  GglDae dae(sys, 7.0);
+  const int n = dae.size();
+  std::vector<double> y, yp, values(dae.jacobian_pattern().nnz());
+  testing::dae_vectors(random_state(sys, 9), n, true, y, yp);
+  ASSERT_EQ(dae.jacobian(0.3, 0.0, y.data(), yp.data(), values.data()), 0);
+  std::vector<double> x[2], out[2], ref[2];
+  for (int i = 0; i < 2; ++i) {
+    x[i].resize(n);
+    for (int k = 0; k < n; ++k) x[i][k] = std::sin(1.0 + k * (i + 2.0));
+    out[i].assign(n, 0.0);
+    ref[i].assign(n, 0.0);
+    csc_multiply(dae.jacobian_pattern(), values.data(), x[i].data(), ref[i].data());
+  }
+  const double* xs[2] = {x[0].data(), x[1].data()};
+  double* outs[2] = {out[0].data(), out[1].data()};
+  dae.jacobian_times(0.3, y.data(), yp.data(), 2, xs, outs);
+  double worst = 0, largest = 0;
+  for (int i = 0; i < 2; ++i)
+    for (int k = 0; k < n; ++k) {
+      worst = std::max(worst, std::fabs(out[i][k] - ref[i][k]) / (1 + std::fabs(ref[i][k])));
+      largest = std::max(largest, std::fabs(ref[i][k]));
+    }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(largest, 1.0);
+  RecordProperty("worst_relative_difference", testing::sci(worst));
 }
 
 // Loads may read only sensors with a known gradient, and not each other.
