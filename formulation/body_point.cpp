@@ -37,11 +37,4 @@ LocalState local_state(const Vec14& y) {
   return s;
 }
 
-Vec14 gather_local(const double* x, int bi, int bj) {
-  Vec14 v = Vec14::Zero();
-  if (bi >= 0) v.head<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bi);
-  if (bj >= 0) v.tail<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bj);
-  return v;
-}
-
 }  // namespace mbdae

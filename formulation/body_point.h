@@ -51,7 +51,14 @@ inline LocalState gather(const double* q, int bi, int bj) {
   }
   return s;
 }
-Vec14 gather_local(const double* x, int bi, int bj);  // local 14-vector (zeros for ground)
+// The local 14-vector [x_bi; x_bj] of a global vector (zeros for ground). Inline: every Jacobian
+// product gathers its vectors per constraint and force.
+inline Vec14 gather_local(const double* x, int bi, int bj) {
+  Vec14 v = Vec14::Zero();
+  if (bi >= 0) v.head<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bi);
+  if (bj >= 0) v.tail<7>() = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(x + 7 * bj);
+  return v;
+}
 // A LocalState as the local 14-vector [ri, pi, rj, pj], and back.
 Vec14 local_vector(const LocalState& s);
 LocalState local_state(const Vec14& y);
