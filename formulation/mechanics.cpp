@@ -220,20 +220,36 @@ void assemble_inertia_derivatives(const System& sys, const double* q, const doub
   }
 }
 
+namespace {
+
+// L(p) y and L(p)^T w without the 3 x 4 matrix: L(p) = [-e, e0 I - [e]x], e = p's vector part.
+inline Vec3 L_times(const Vec4& p, const Vec4& y) {
+  const Vec3 e = p.tail<3>(), yv = y.tail<3>();
+  return p[0] * yv - e.cross(yv) - y[0] * e;
+}
+inline Vec4 Lt_times(const Vec4& p, const Vec3& w) {
+  const Vec3 e = p.tail<3>();
+  Vec4 r;
+  r[0] = -e.dot(w);
+  r.tail<3>() = p[0] * w + e.cross(w);
+  return r;
+}
+
+}  // namespace
+
 void inertia_derivatives_times(const System& sys, const double* q, const double* v, const double* acc, int row0,
                                int colq, int colv, int count, const double* const* x, double* const* out) {
   for (int b = 0; b < sys.num_bodies(); ++b) {
     const Mat3& j = sys.bodies[b].inertia;
     const int o = 7 * b + 3;
     const Vec4 p = p_of(q, b), pd = p_of(v, b), pdd = p_of(acc, b);
-    const Mat34 l = L_matrix(p), ld = L_matrix(pd), la = L_matrix(pdd);
-    const Vec3 jla = j * (l * pdd), jlpd = j * (l * pd);
+    const Vec3 jla = j * L_times(p, pdd), jlpd = j * L_times(p, pd);
     for (int i = 0; i < count; ++i) {
       const Vec4 xq = Eigen::Map<const Vec4>(x[i] + colq + o), xv = Eigen::Map<const Vec4>(x[i] + colv + o);
       // As assemble_inertia_derivatives' blocks times (xq, xv), with P(w) x = L(x)^T w.
-      const Vec4 r = 4.0 * (L_matrix(xq).transpose() * jla - l.transpose() * (j * (la * xq))) -
-                     8.0 * ld.transpose() * (j * (ld * xq)) +
-                     8.0 * (L_matrix(xv).transpose() * jlpd + ld.transpose() * (j * (l * xv)));
+      const Vec4 r = 4.0 * (Lt_times(xq, jla) - Lt_times(p, j * L_times(pdd, xq))) -
+                     8.0 * Lt_times(pd, j * L_times(pd, xq)) +
+                     8.0 * (Lt_times(xv, jlpd) + Lt_times(pd, j * L_times(p, xv)));
       Eigen::Map<Vec4>(out[i] + row0 + o) += r;
     }
   }
