@@ -25,6 +25,33 @@ inline bool in_pattern(const Constraint& c, int l) {
   return global_index(c.bi, c.bj, l) >= 0 && (l % 7 >= 3 || constraint_hessian_touches_r(c));
 }
 
+// H x for a constraint row's local Hessian; without position entries (!touches_r) only its
+// two 4 x 4 rotation blocks' rows and columns (the assembly leaves the rest out as well).
+Vec14 hessian_times(const Mat14& h, const Vec14& x, bool touches_r) {
+  if (touches_r) return h.lazyProduct(x);
+  static constexpr int kRot[8] = {3, 4, 5, 6, 10, 11, 12, 13};
+  Vec14 out = Vec14::Zero();
+  for (int a : kRot) {
+    double sum = 0;
+    for (int b : kRot) sum += h(a, b) * x[b];
+    out[a] = sum;
+  }
+  return out;
+}
+
+// The Hessian terms of one constraint for one x (local vectors): f1 += sum mu_r H_r x,
+// f2 += sum lambda_r H_r x and g[r] = (H_r v)^T x, from the row Hessians h.
+void hessian_terms(const Constraint& c, const Mat14* h, const Vec14& x, const Vec14& vl, const double* mu,
+                   const double* lambda, Vec14& f1, Vec14& f2, double* g) {
+  const bool touches_r = constraint_hessian_touches_r(c);
+  for (int r = 0; r < c.rows(); ++r) {
+    const Vec14 hx = hessian_times(h[r], x, touches_r);
+    f1 += mu[r] * hx;
+    f2 += lambda[r] * hx;
+    g[r] = vl.dot(hx);
+  }
+}
+
 }  // namespace
 
 void velocity_rows(const Constraint& c, const Row14* rows, const double* v, double t, double* out) {
@@ -32,6 +59,15 @@ void velocity_rows(const Constraint& c, const Row14* rows, const double* v, doub
   constraint_time_derivatives(c, t, pt, ptt);
   const Vec14 vl = gather_local(v, c.bi, c.bj);
   for (int r = 0; r < c.rows(); ++r) out[r] = rows[r].dot(vl) + pt[r];
+}
+
+void constraint_hessian_terms(const Constraint& c, const LocalState& s, const Vec14& x, const Vec14& v,
+                              const double* mu, const double* lambda, Vec14& f1, Vec14& f2, double* g, Mat14* h,
+                              bool& have_h) {
+  if (constraint_hessian_products(c, s, x, v, mu, lambda, f1, f2, g)) return;
+  if (!have_h) row_hessians(c, s, h);
+  have_h = true;
+  hessian_terms(c, h, x, v, mu, lambda, f1, f2, g);
 }
 
 void velocity_constraint_values(const System& sys, const std::vector<int>& off, const double* q,

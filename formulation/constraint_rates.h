@@ -24,6 +24,13 @@ namespace mbdae {
 void row_hessians(const Constraint& c, const LocalState& s, Mat14* h);
 // Phi_q v + Phi_t of constraint c's rows, its Jacobian rows given (v global).
 void velocity_rows(const Constraint& c, const Row14* rows, const double* v, double t, double* out);
+// The Hessian terms of constraint c's rows along x (local, like v): f1 += sum_r mu_r H_r x,
+// f2 += sum_r lambda_r H_r x and g[r] = v^T H_r x. In closed form where the type has one
+// (constraint_hessian_products, constraints.h), else from the row Hessians h[3]: computed at the
+// first call for the constraint's state (have_h false, then set) and reused for the next x.
+void constraint_hessian_terms(const Constraint& c, const LocalState& s, const Vec14& x, const Vec14& v,
+                              const double* mu, const double* lambda, Vec14& f1, Vec14& f2, double* g, Mat14* h,
+                              bool& have_h);
 
 // Phi_q v + Phi_t (the velocity-level constraints).
 void velocity_constraint_values(const System& sys, const std::vector<int>& offsets,

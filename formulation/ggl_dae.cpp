@@ -48,36 +48,6 @@ void GglDae::assemble(double t, double cj, const double* y, const double* yp) {
   assemble_hessian_vector_rows(sys_, offsets_, q, v, scale_, nullptr, 0.0, rw, cq, asm_);
 }
 
-namespace {
-// H x for a constraint row's local Hessian; without position entries (!touches_r) only its
-// two 4 x 4 rotation blocks' rows and columns (the assembly leaves the rest out as well).
-Vec14 hessian_times(const Mat14& h, const Vec14& x, bool touches_r) {
-  if (touches_r) return h.lazyProduct(x);
-  static constexpr int kRot[8] = {3, 4, 5, 6, 10, 11, 12, 13};
-  Vec14 out = Vec14::Zero();
-  for (int a : kRot) {
-    double sum = 0;
-    for (int b : kRot) sum += h(a, b) * x[b];
-    out[a] = sum;
-  }
-  return out;
-}
-
-// The Hessian terms of one constraint for one x (local vectors): f1 += sum mu_r H_r x,
-// f2 += sum lambda_r H_r x and g[r] = (H_r v)^T x, from the row Hessians h.
-void hessian_terms(const Constraint& c, const Mat14* h, const Vec14& x, const Vec14& vl, const double* mu,
-                   const double* lambda, Vec14& f1, Vec14& f2, double* g) {
-  const bool touches_r = constraint_hessian_touches_r(c);
-  for (int r = 0; r < c.rows(); ++r) {
-    const Vec14 hx = hessian_times(h[r], x, touches_r);
-    f1 += mu[r] * hx;
-    f2 += lambda[r] * hx;
-    g[r] = vl.dot(hx);
-  }
-}
-
-}  // namespace
-
 void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int count, const double* const* x,
                             double* const* out) {
   const double t = input_time(t_in);
@@ -106,11 +76,7 @@ void GglDae::jacobian_times(double t_in, const double* y, const double* yp, int 
       const Vec14 xq = gather_local(xi, c.bi, c.bj), xv = gather_local(xi + nq_, c.bi, c.bj);
       Vec14 f1 = Vec14::Zero(), f2 = Vec14::Zero();
       double g[3];
-      if (!constraint_hessian_products(c, s, xq, vl, mu + o, lambda + o, f1, f2, g)) {
-        if (!have_h) row_hessians(c, s, h);
-        have_h = true;
-        hessian_terms(c, h, xq, vl, mu + o, lambda + o, f1, f2, g);
-      }
+      constraint_hessian_terms(c, s, xq, vl, mu + o, lambda + o, f1, f2, g, h, have_h);
       for (int r = 0; r < c.rows(); ++r) {
         const int row = o + r;
         f1 += xi[2 * nq_ + nc_ + row] * rows[r].transpose();           // Phi_q^T x_mu

@@ -48,11 +48,11 @@ class GglDae : public MultibodyDae {
   // rtol|lambda| + m_ref (atol + noise/h)/h.
   void error_weights(double h, const double* y, double rtol, double atol, double* w) const override;
   std::string component_name(int i) const override;
-  // F_y x[i] without the assembly: the kinematic, force and inertia terms by the assembling
-  // code's product pass; each constraint's rows once for Phi_q and Phi_q^T of every x[i], and
-  // its three Hessian terms (sum mu_k H_k, sum lambda_k H_k, (H_k v)^T) in closed form where
-  // its type has one (constraint_hessian_products), else from its row Hessians, computed once;
-  // the assembly computes the Hessians five times for a three-row constraint and stores the matrix.
+  // F_y x[i] without the assembly: the inertia and force terms as products with x
+  // (inertia_derivatives_times, force_derivatives_times); each constraint's rows once for Phi_q
+  // and Phi_q^T of every x[i], and its three Hessian terms (sum mu_k H_k, sum lambda_k H_k,
+  // (H_k v)^T) by constraint_hessian_terms; the assembly computes the Hessians five times for a
+  // three-row constraint and stores the matrix.
   void jacobian_times(double t, const double* y, const double* yp, int count, const double* const* x,
                       double* const* out) override;
   // Phi_q^T mu (F1) and Phi_q^T lambda (F2) of constraint k, and its rows of F3 = s Phi and

@@ -90,11 +90,7 @@ void KinematicSensitivities::velocity_sides(const double* q, const double* v, do
       const Vec14 xq = gather_local(sq_cols_[i], c.bi, c.bj);
       Vec14 f1 = Vec14::Zero(), f2 = Vec14::Zero();
       double g[3] = {0, 0, 0};
-      if (!constraint_hessian_products(c, s, xq, vl, zero, zero, f1, f2, g)) {
-        if (!have_h) row_hessians(c, s, h);
-        have_h = true;
-        for (int r = 0; r < c.rows(); ++r) g[r] = vl.dot(h[r] * xq);
-      }
+      constraint_hessian_terms(c, s, xq, vl, zero, zero, f1, f2, g, h, have_h);
       for (int r = 0; r < c.rows(); ++r) sv_cols_[i][offsets_[k] + r] = -g[r];
     }
   }
