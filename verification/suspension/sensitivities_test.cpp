@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cases/mbdae.h"
+#include "cases/tests/run_command.h"  // read_file
 #include "core/errors.h"
 
 namespace mbdae {
@@ -200,14 +201,8 @@ TEST(SuspensionSensitivities, DynamicsIWheelAgainstTheGroundStepsTime) {
 // 1e-11 runs with a step of 3e-7 s, which keeps the landing after the push.
 TEST(SuspensionSensitivities, DynamicsIWheelAgainstAPushSteppingJustBeforeALanding) {
   const std::string file = std::string(MBDAE_SOURCE_DIR) + "/cases/five_point_suspension/dynamics_step.yaml";
-  std::string text;
-  {
-    std::FILE* f = std::fopen(file.c_str(), "rb");
-    ASSERT_NE(f, nullptr);
-    char buf[4096];
-    for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
-    std::fclose(f);
-  }
+  std::string text = test_support::read_file(file);
+  ASSERT_FALSE(text.empty()) << file;
   const std::string output = "output:";
   text.insert(text.find(output), "  - {name: push, type: point_force, body: wheel, point: origin, fz: {type: step, "
                                  "time: 0.2358125, before: 0, after: 800.0}}\n");
