@@ -198,7 +198,7 @@ bool AugmentedSolver::refine_accelerations(const double* q, double t, double tol
   double* x = work2_.data();
   predict_accelerations(t, std::min(points_, history_size_), x);
   constraint_jacobian_rows(sys_, q, rows_);
-  if (!refine(q, rhs_.data(), x, t, tolerance)) return false;
+  if (!refine(q, rhs_.data(), x, t, tolerance, "the accelerations and constraint forces")) return false;
   std::copy(work2_.begin(), work2_.end(), rhs_.begin());
   return true;
 }
@@ -209,7 +209,8 @@ bool AugmentedSolver::refine_accelerations(const double* q, double t, double tol
 // corrections (per block, a and lambda). Accepted when that estimate is below `tolerance` of the
 // block's max norm (for a, or the rounding of b's forces, 1e3 eps |b_Q| / m); a slow (rho > 0.5)
 // or diverging iteration is not.
-bool AugmentedSolver::refine(const double* q, const double* b, double* x, double t, double tolerance) {
+bool AugmentedSolver::refine(const double* q, const double* b, double* x, double t, double tolerance,
+                             const char* what) {
   const int n = nq_ + nc_;
   // The accelerations cannot be resolved below the rounding of the force balance, about eps |Q| / m
   // (gravity for a body it pulls): a mechanism at rest has a = 0 up to that rounding, and a
@@ -247,8 +248,7 @@ bool AugmentedSolver::refine(const double* q, const double* b, double* x, double
     }
     if (hopeless && !converged) return false;
     if (converged) {
-      check_overflow(x, n, t, "the accelerations and constraint forces",
-                     "a force against a small mass or inertia");
+      check_overflow(x, n, t, what, "a force against a small mass or inertia");
       return true;
     }
   }
@@ -275,7 +275,8 @@ bool AugmentedSolver::output_derivative(const double* q, double t, const double*
     check_overflow(dx, n, t, "the accelerations' sensitivities", "a force against a small mass or inertia");
     return true;
   }
-  return refine(q, g, dx, t, tolerance);  // rows_ are the sample's (refine_accelerations)
+  // rows_ are the sample's (refine_accelerations)
+  return refine(q, g, dx, t, tolerance, "the accelerations' sensitivities");
 }
 
 void AugmentedSolver::check_overflow(const double* x, int n, double t, const char* what,

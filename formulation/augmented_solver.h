@@ -84,7 +84,8 @@ class AugmentedSolver {
   void acceleration_right_side(const std::vector<char>& modes, const double* q, const double* v, double t);
   void acceleration_residual(const double* q, const double* b, const double* x, double* r) const;
   bool refine_accelerations(const double* q, double t, double tolerance);
-  bool refine(const double* q, const double* b, double* x, double t, double tolerance);
+  // `what` names x in an overflow's message.
+  bool refine(const double* q, const double* b, double* x, double t, double tolerance, const char* what);
   void remember_output(double t);
   void check_overflow(const double* x, int n, double t, const char* what, const char* cause) const;
   const System& sys_;

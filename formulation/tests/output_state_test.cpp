@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
+#include "core/errors.h"
 #include "formulation/augmented_solver.h"
 #include "formulation/index3_dae.h"
 #include "formulation/redundancy.h"
@@ -138,6 +141,33 @@ TEST(OutputState, MechanismAtRestIsRefined) {
   std::printf("at rest: refined %ld, direct %ld, largest |a| of the direct solve %.2e\n",
               sampler.refinement.refined, sampler.refinement.direct, largest);
   EXPECT_GE(sampler.refinement.refined, 95);
+}
+
+// The sensitivities' solve on a sample's factorization (output_derivative) names what overflowed
+// as the sensitivities, whether the sample was factored (its first: one solve) or refined.
+TEST(OutputState, SensitivitiesThatOverflowAreNamedSo) {
+  System sys = build_system(testing::pendulum(1.37, 0.523, 0.0217, 0.3));
+  std::vector<double> q = sys.q0, v(sys.nq(), 0.0), a(sys.nq());
+  AugmentedSolver sampler(sys);
+  ASSERT_TRUE(sampler.positions(q.data(), 0.0, 1e-13, 50).converged);
+  sampler.prepare_output_accelerations();
+  const std::vector<char> modes(sys.forces.size(), 0);
+  const int n = sys.nq() + sys.num_constraint_rows();
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(sampler.output_accelerations(modes, q.data(), v.data(), 1e-3 * k, a.data(), 1e-10));
+    std::vector<double> g(n, 1.0), dx(n, 0.0);
+    g[0] = NAN;
+    try {
+      sampler.output_derivative(q.data(), 1e-3 * k, g.data(), dx.data(), 1e-10);
+      ADD_FAILURE() << "sample " << k << ": a NaN right side gave no error";
+    } catch (const SolveError& e) {
+      EXPECT_EQ(e.status, "overflow");
+      EXPECT_NE(std::string(e.what()).find("the accelerations' sensitivities are not finite"), std::string::npos)
+          << "sample " << k << ": " << e.what();
+    }
+  }
+  EXPECT_GE(sampler.refinement.refined, 1);
+  EXPECT_GE(sampler.refinement.direct, 1);
 }
 
 }  // namespace
